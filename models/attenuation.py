@@ -1,0 +1,151 @@
+"""Attenuation factor AF(t) and attenuated force F_A(t) (paper eqs 16-18).
+
+``AF = r(phi) / r(0)``: the NAP boundary radius along the shear direction,
+normalised so that AF = 1 when theta_R = theta_T (DDMM-NOTES §1.3).  When the
+shear magnitude F_S is at or below F_TH the paper gives two readings of "no
+shear" (DDMM-NOTES §1.5), selected by ``no_shear``:
+
+* ``"pass"`` (default, eq. 17): AF = 1, normal loading passes unattenuated.
+* ``"block"`` (the Discussion's reading): AF = 0, nothing passes until shear
+  appears.
+
+The conventional model (CMM) is the same pipeline with AF = 1 everywhere:
+profile ``"none"``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._validation import as_finite_array, check_choice, check_positive
+from .nap import boundary_radius, get_profile, tip_radius, validate_k
+
+__all__ = [
+    "F_TH",
+    "NO_SHEAR_READINGS",
+    "UNTUNED",
+    "shear_magnitude",
+    "attenuation_factor",
+    "attenuated_force",
+]
+
+#: Shear threshold F_TH in newtons below which no direction is defined (eq. 17).
+F_TH = 0.1
+#: The two readings of "no shear" (DDMM-NOTES §1.5); eq. 17 ("pass") is the default.
+NO_SHEAR_READINGS = ("pass", "block")
+#: Profile name of an untuned afferent, i.e. the CMM (AF = 1).
+UNTUNED = "none"
+
+
+def shear_magnitude(fx, fy) -> np.ndarray:
+    """Resultant shear F_S = sqrt(F_X^2 + F_Y^2) in newtons (eq. 16).
+
+    Examples
+    --------
+    >>> float(shear_magnitude(3.0, 4.0))
+    5.0
+    """
+    return np.hypot(np.asarray(fx, dtype=float), np.asarray(fy, dtype=float))
+
+
+def _unique_directions(fx, fy, active):
+    """Unit shear vectors of the active samples, deduplicated.
+
+    Scenes usually push in few directions, so the radius is solved once per
+    distinct direction and gathered; identical inputs give identical outputs,
+    so this is exact.
+    """
+    mag = np.hypot(fx[active], fy[active])
+    unit = np.stack([fx[active] / mag, fy[active] / mag], axis=1)
+    uniq, inverse = np.unique(unit, axis=0, return_inverse=True)
+    return uniq[:, 0], uniq[:, 1], inverse.ravel()
+
+
+def attenuation_factor(
+    fx,
+    fy,
+    theta_t,
+    profile: str,
+    k=3.0,
+    *,
+    f_th: float = F_TH,
+    no_shear: str = "pass",
+) -> np.ndarray:
+    """Attenuation factor AF for each sample and afferent (eqs 16-17).
+
+    Parameters
+    ----------
+    fx, fy : array_like, shape (n_samples,)
+        Shear force components in newtons; +X radial, +Y distal.
+    theta_t : float or array_like, shape (n_afferents,)
+        Tuning angles theta_T in degrees (counter-clockwise from +X).
+    profile : str
+        ``"selective"``, ``"broad"``, ``"bipolar"`` or ``"none"`` (CMM, AF = 1).
+    k : float or array_like, shape (n_afferents,)
+        Sharpness of eq. 12 (dimensionless), default 3 as in the paper.
+    f_th : float
+        Shear threshold F_TH in newtons (default 0.1 N, eq. 17).
+    no_shear : {"pass", "block"}
+        AF when F_S <= F_TH: 1 (eq. 17) or 0 (the Discussion's reading).
+
+    Returns
+    -------
+    af : ndarray, shape (n_samples, n_afferents)
+        Dimensionless AF in [0, 1].
+
+    Examples
+    --------
+    >>> af = attenuation_factor([0.0, 0.0], [0.05, 1.0], [90.0, 270.0], "selective")
+    >>> af.round(3).tolist()
+    [[1.0, 1.0], [1.0, 0.2]]
+    """
+    fx = as_finite_array(fx, "fx", ndim=1)
+    fy = as_finite_array(fy, "fy", ndim=1)
+    if fx.shape != fy.shape:
+        raise ValueError(f"fx and fy must have equal length; got {fx.size} and {fy.size}")
+    theta = np.atleast_1d(as_finite_array(theta_t, "theta_t"))
+    if theta.ndim != 1:
+        raise ValueError(f"theta_t must be a scalar or 1-D, got shape {theta.shape}")
+    f_th = check_positive(f_th, "f_th", "N")
+    check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
+    if profile != UNTUNED:
+        prof = get_profile(profile)
+        k = np.broadcast_to(validate_k(k, prof), theta.shape)
+    active = shear_magnitude(fx, fy) > f_th
+    outside = 1.0 if (no_shear == "pass" or profile == UNTUNED) else 0.0
+    af = np.full((fx.size, theta.size), outside)
+    if profile == UNTUNED:
+        af[active] = 1.0
+        return af
+    if not np.any(active):
+        return af
+    ux, uy, inverse = _unique_directions(fx, fy, active)
+    rad = np.deg2rad(theta)
+    ct, st = np.cos(rad), np.sin(rad)
+    cos_phi = ux[:, None] * ct + uy[:, None] * st
+    sin_phi = uy[:, None] * ct - ux[:, None] * st
+    radius = boundary_radius(sin_phi, cos_phi, prof, k) / tip_radius(prof)
+    # For k < 1 (theta_A > 90 deg with b = 1) a profile is wider than its tip
+    # is long, so r(phi) > r(0) off-axis; AF saturates at 1 (no attenuation).
+    af[active] = np.minimum(radius, 1.0)[inverse]
+    return af
+
+
+def attenuated_force(fz, af) -> np.ndarray:
+    """Attenuated force F_A = AF * F_Z in newtons (eq. 18).
+
+    Parameters
+    ----------
+    fz : array_like, shape (n_samples,)
+        Normal force in newtons.
+    af : array_like, shape (n_samples, n_afferents)
+        Attenuation factors from `attenuation_factor`.
+
+    Examples
+    --------
+    >>> attenuated_force([2.0], [[0.5, 1.0]]).tolist()
+    [[1.0, 2.0]]
+    """
+    fz = np.asarray(fz, dtype=float)
+    return np.asarray(af, dtype=float) * fz[:, None]
+

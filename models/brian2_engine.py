@@ -1,0 +1,225 @@
+"""The Brian2 engine: eqs 4-6 in Brian2's C++ standalone mode, compiled once per shape.
+
+Design (measured on this machine kind, see README "Engines"):
+
+* **Standalone, built once per shape.**  A project is generated for a padded
+  shape ``(n_neurons, n_samples)`` plus dt, substeps and method, compiled
+  once and cached on disk (``$DDMM_CACHE_DIR/brian2/<key>``, default
+  ``~/.cache/ddmm``).  Calls that change only input values re-run the same
+  binary with Brian2's ``run_args``: the currents (a `TimedArray`), the
+  initial v and u, and the per-neuron a, b, c, d are all files handed to the
+  binary, so nothing recompiles.  A one-line notice is printed whenever a
+  shape is compiled.
+* **Inputs at the force rate.**  The current is sampled at ``fs`` and held
+  for ``substeps`` steps: a ``run_regularly`` operation at ``1/fs`` copies
+  the TimedArray row into ``I_in``, which the state updater reads.
+* **Same arithmetic as the direct engine.**  The project is compiled without
+  ``-ffast-math`` and with ``-ffp-contract=off`` (no fused multiply-adds),
+  and `models.direct` mirrors the generated expressions.
+* **Padding is exact.**  Extra neurons get zero current and are dropped;
+  extra samples come after the end and their spikes are dropped.  The state
+  at the true end is captured in ``v_end, u_end`` by the same operation when
+  ``t`` reaches ``t_end`` (a run argument), before the padded steps run.
+* **32-bit TimedArray index.**  Brian2 indexes ``timestep*N + i`` with an
+  ``int``; runs are cut into time chunks so that ``n_samples * n_neurons``
+  stays far below 2**31.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import sys
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["run_brian2", "cache_dir"]
+
+_COMPILE_ARGS = ["-w", "-O3", "-ffp-contract=off", "-march=native", "-std=c++11"]
+_TEMPLATE_VERSION = "1"  # bump when the generated network changes
+_NEURON_QUANTUM = 32  # neuron padding granularity
+_SAMPLE_QUANTUM = 250  # sample padding granularity
+_MAX_ELEMENTS = 1 << 25  # TimedArray elements per run: 256 MB, far below 2**31
+
+_EQUATIONS = """
+dv/dt = (0.04*v**2 + 5*v + 140 - u + I_in)/ms : 1
+du/dt = a*(b*v - u)/ms : 1
+I_in : 1
+v_end : 1
+u_end : 1
+t_end : second (shared)
+a : 1
+b : 1
+c : 1
+d : 1
+"""
+
+
+def cache_dir() -> Path:
+    """Root of the on-disk Brian2 build cache (``$DDMM_CACHE_DIR`` or ``~/.cache/ddmm``)."""
+    root = os.environ.get("DDMM_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "ddmm"
+    )
+    return Path(root) / "brian2"
+
+
+@dataclass
+class _Build:
+    """A generated and compiled standalone project, live in this process."""
+
+    key: tuple
+    directory: Path
+    group: object
+    monitor: object
+    timed_array: object
+    device: object  # the cpp_standalone device that built the project
+    n_neurons: int
+    n_samples: int
+    duration: float  # seconds simulated by one run of the binary
+
+
+_ACTIVE: _Build | None = None
+
+
+def _pad(n: int, quantum: int) -> int:
+    return max(quantum, -(-n // quantum) * quantum)
+
+
+def _key_dir(key: tuple) -> Path:
+    import brian2
+
+    text = repr((key, brian2.__version__, _COMPILE_ARGS, _TEMPLATE_VERSION, _EQUATIONS))
+    digest = hashlib.sha256(text.encode()).hexdigest()[:16]
+    n_neurons, n_samples, substeps, dt, method = key
+    return cache_dir() / f"n{n_neurons}_t{n_samples}_s{substeps}_{method}_{digest}"
+
+
+@contextmanager
+def _brian2_prefs():
+    """Set the preferences the build needs, restoring the user's afterwards."""
+    import brian2
+
+    saved = {
+        "codegen.cpp.extra_compile_args_gcc": list(brian2.prefs["codegen.cpp.extra_compile_args_gcc"]),
+        "devices.cpp_standalone.openmp_threads": brian2.prefs["devices.cpp_standalone.openmp_threads"],
+    }
+    brian2.prefs["codegen.cpp.extra_compile_args_gcc"] = list(_COMPILE_ARGS)
+    brian2.prefs["devices.cpp_standalone.openmp_threads"] = 0
+    try:
+        yield brian2
+    finally:
+        for name, value in saved.items():
+            brian2.prefs[name] = value
+
+
+def _build(key: tuple) -> _Build:
+    """Generate (and if needed compile) the standalone project for ``key``."""
+    n_neurons, n_samples, substeps, dt, method = key
+    directory = _key_dir(key)
+    compiled = (directory / "main").exists()
+    if not compiled:
+        print(
+            f"ddmm: compiling the Brian2 engine for {n_neurons} neurons x {n_samples} samples "
+            f"(dt={dt * 1e3:g} ms, {method}); once per shape, cached in {directory}",
+            file=sys.stderr,
+            flush=True,
+        )
+    with _brian2_prefs() as b2:
+        b2.device.reinit()
+        b2.device.activate(directory=str(directory), build_on_run=False)
+        b2.set_device("cpp_standalone", directory=str(directory), build_on_run=False)
+        fs = 1.0 / (dt * substeps)
+        ta = b2.TimedArray(np.zeros((n_samples, n_neurons)), dt=(1.0 / fs) * b2.second, name="ddmm_current")
+        group = b2.NeuronGroup(
+            n_neurons, _EQUATIONS, threshold="v >= 30", reset="v = c; u += d",
+            method=method, dt=dt * b2.second, name="afferents", namespace={"ms": b2.ms},
+        )
+        # Hold the current for one sample; when t reaches t_end (the end of the
+        # real input) copy the state, which later padded steps then overwrite.
+        code = (
+            "I_in = ddmm_current(t, i)\n"
+            f"at_end = int(abs(t - t_end) < {0.5 / fs!r}*second)\n"
+            "v_end = at_end*v + (1 - at_end)*v_end\n"
+            "u_end = at_end*u + (1 - at_end)*u_end"
+        )
+        group.run_regularly(code, dt=(1.0 / fs) * b2.second, when="start")
+        for var, value in (("a", 0.02), ("b", 0.2), ("c", -65.0), ("d", 8.0), ("v", -70.0),
+                           ("u", -14.0), ("v_end", -70.0), ("u_end", -14.0)):
+            setattr(group, var, value)
+        group.t_end = n_samples * substeps * dt * b2.second
+        monitor = b2.SpikeMonitor(group, name="spikes")
+        net = b2.Network(group, monitor)
+        net.run(n_samples * substeps * dt * b2.second, namespace={"ddmm_current": ta, "ms": b2.ms})
+        device = b2.get_device()
+        device.build(directory=str(directory), run=False, with_output=False)
+        b2.set_device("runtime")  # leave the user's Brian2 in its default mode
+    return _Build(key, directory, group, monitor, ta, device, n_neurons, n_samples, n_samples * substeps * dt)
+
+
+def _activate(key: tuple) -> _Build:
+    global _ACTIVE
+    if _ACTIVE is None or _ACTIVE.key != key:
+        _ACTIVE = None
+        _ACTIVE = _build(key)
+    return _ACTIVE
+
+
+def _run_chunk(build: _Build, current, params, v, u):
+    """Run the compiled binary once on a padded chunk; return spikes and final state."""
+    static = build.directory / "static_arrays"
+    n_real = current.shape[1]
+    padded = np.zeros((build.n_samples, build.n_neurons))
+    padded[: current.shape[0], :n_real] = current
+    files = {"ddmm_current.values": padded}
+    for name, arr, fill in (("v", v, -70.0), ("u", u, -14.0), ("a", params["a"], 0.02),
+                            ("b", params["b"], 0.2), ("c", params["c"], -65.0), ("d", params["d"], 8.0)):
+        full = np.full(build.n_neurons, fill)
+        full[:n_real] = arr
+        files[f"afferents.{name}"] = full
+    t_end = current.shape[0] * build.key[2] * build.key[3]  # samples * substeps * dt, in s
+    run_args = [f"afferents.t_end={t_end!r}"]
+    for target, arr in files.items():
+        fname = f"ddmm_{target.replace('.', '_')}.dat"
+        np.ascontiguousarray(arr, dtype=np.float64).tofile(static / fname)
+        run_args.append(f"{target}=static_arrays/{fname}")
+    build.device.run(directory=str(build.directory), with_output=False, run_args=run_args)
+    neuron = np.asarray(build.monitor.i[:], dtype=np.int64)
+    step = np.rint(np.asarray(build.monitor.t_[:]) / (build.key[3])).astype(np.int64)
+    keep = neuron < n_real
+    padded_tail = current.shape[0] < build.n_samples
+    v_name, u_name = ("v_end", "u_end") if padded_tail else ("v", "u")
+    v_final = np.asarray(getattr(build.group, v_name)[:])[:n_real]
+    u_final = np.asarray(getattr(build.group, u_name)[:])[:n_real]
+    return neuron[keep], step[keep], v_final, u_final
+
+
+def run_brian2(current, substeps, dt, params, v, u, method="euler", v_peak=30.0):
+    """Integrate eqs 4-6 for N neurons with Brian2 (same contract as `run_direct`).
+
+    ``v`` and ``u`` are updated in place to the final state.  Returns
+    ``(neuron, step)`` int64 arrays sorted by step then neuron.
+    """
+    if v_peak != 30.0:
+        raise ValueError(f"v_peak={v_peak!r}: the Brian2 engine is built for the paper's 30 mV")
+    n_samples_total, n_neurons = current.shape
+    n_pad = _pad(n_neurons, _NEURON_QUANTUM)
+    chunk = max(_SAMPLE_QUANTUM, (_MAX_ELEMENTS // n_pad) // _SAMPLE_QUANTUM * _SAMPLE_QUANTUM)
+    t_pad = min(_pad(n_samples_total, _SAMPLE_QUANTUM), chunk)
+    build = _activate((n_pad, t_pad, int(substeps), float(dt), method))
+    neurons, steps = [], []
+    for start in range(0, n_samples_total, t_pad):
+        part = current[start : start + t_pad]
+        nrn, stp, v_new, u_new = _run_chunk(build, part, params, v, u)
+        n_valid = part.shape[0] * substeps
+        keep = stp < n_valid  # spikes in the zero padding after the end are not real
+        neurons.append(nrn[keep])
+        steps.append(stp[keep] + start * substeps)
+        v[:], u[:] = v_new, u_new
+    neuron = np.concatenate(neurons)
+    step = np.concatenate(steps)
+    order = np.lexsort((neuron, step))
+    return neuron[order], step[order]
+

@@ -1,0 +1,220 @@
+"""Afferent currents from the attenuated force (paper eqs 1-3).
+
+* SAI follows force:            ``I = g_sai * |F_A|``           (eq. 1)
+* RAI its rate of change:       ``I = g_rai * |dF_A/dt|``       (eq. 2)
+* RAII its acceleration:        ``I = g_raii * |d^2F_A/dt^2|``  (eq. 3)
+
+Derivatives of a raw force signal are useless (DDMM-NOTES §1.6), so F_A is
+low-passed first by a *causal* Butterworth filter and differentiated by
+backward differences.  Both keep explicit state (`FilterState`), so a signal
+cut into chunks gives exactly the currents of the whole signal: streaming and
+offline runs agree bit for bit.
+
+Currents are in the Izhikevich model's own units (mV/ms, the units of
+``dv/dt`` in eq. 4); the gains convert newtons to them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from scipy import signal
+
+from ._validation import as_finite_array, check_choice, check_positive
+
+__all__ = [
+    "AFFERENT_TYPES",
+    "CurrentParams",
+    "FilterState",
+    "lowpass_sos",
+    "initial_filter_state",
+    "filter_force",
+    "afferent_current",
+]
+
+#: The afferent types of the model, in the order used throughout the package.
+AFFERENT_TYPES = ("SAI", "RAI", "RAII")
+
+
+@dataclass(frozen=True)
+class CurrentParams:
+    """Gains and derivative filter of the current stage (eqs 1-3).
+
+    The gains are calibrated so that the CMM (AF = 1) press-push-lift response
+    lies near paper Table III (SAI about 47.5 pulses/s, RAI and RAII 10-20);
+    ``experiments/calibrate_core.py`` reproduces the fit.
+
+    Attributes
+    ----------
+    g_sai : float
+        SAI gain, (mV/ms) per N (eq. 1).
+    g_rai : float
+        RAI gain, (mV/ms) per (N/s) (eq. 2).
+    g_raii : float
+        RAII gain, (mV/ms) per (N/s^2) (eq. 3).
+    cutoff_hz : float
+        Cut-off of the causal Butterworth low-pass applied to F_A before
+        differentiation, in Hz (DDMM-NOTES §1.6: 20 Hz restores Table III's
+        aligned > misaligned ordering for RAII).
+    filter_order : int
+        Order of that Butterworth filter (2 in the notes' trial).
+    """
+
+    g_sai: float = 5.367  # fitted: CMM SAI SF 47.5 pulses/s (Table III)
+    g_rai: float = 11.035  # fitted: CMM RAI SF 15 pulses/s (Table III)
+    g_raii: float = 6.157  # fitted: CMM RAII SF 10 pulses/s (Table III)
+    cutoff_hz: float = 20.0
+    filter_order: int = 2
+
+    def __post_init__(self):
+        for name in ("g_sai", "g_rai", "g_raii", "cutoff_hz"):
+            check_positive(getattr(self, name), name)
+        if not isinstance(self.filter_order, int) or not 1 <= self.filter_order <= 8:
+            raise ValueError(f"filter_order must be an int in [1, 8], got {self.filter_order!r}")
+
+    def gain(self, afferent_type: str) -> float:
+        """The gain of ``afferent_type`` (``"SAI"``, ``"RAI"`` or ``"RAII"``)."""
+        check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
+        return {"SAI": self.g_sai, "RAI": self.g_rai, "RAII": self.g_raii}[afferent_type]
+
+
+@dataclass(frozen=True)
+class FilterState:
+    """State of the causal low-pass and backward differences between chunks.
+
+    Attributes
+    ----------
+    zi : ndarray, shape (n_sections, 2, n_afferents)
+        Second-order-section state of `scipy.signal.sosfilt`.
+    y1, y2 : ndarray, shape (n_afferents,)
+        The last and second-to-last filtered samples, in newtons.
+    """
+
+    zi: np.ndarray
+    y1: np.ndarray
+    y2: np.ndarray
+
+
+def lowpass_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
+    """Second-order sections of the Butterworth low-pass (cut-off in Hz, fs in Hz).
+
+    Examples
+    --------
+    >>> lowpass_sos(20.0, 2, 1000.0).shape
+    (1, 6)
+    """
+    fs = check_positive(fs, "fs", "Hz")
+    if not cutoff_hz < fs / 2.0:
+        raise ValueError(
+            f"cutoff_hz={cutoff_hz!r} must be below the Nyquist frequency fs/2 = {fs / 2.0} Hz"
+        )
+    return _butter_sos(float(cutoff_hz), int(order), fs).copy()
+
+
+@lru_cache(maxsize=64)
+def _butter_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
+    return signal.butter(order, cutoff_hz, btype="low", fs=fs, output="sos")
+
+
+def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams()) -> FilterState:
+    """Filter state at steady state for a constant input ``f0`` (newtons).
+
+    Starting at steady state means a trace that begins mid-contact produces
+    no spurious derivative at its first sample; a trace that starts at rest
+    (F_A = 0) is unaffected.
+    """
+    f0 = np.atleast_1d(np.asarray(f0, dtype=float))
+    sos = lowpass_sos(params.cutoff_hz, params.filter_order, fs)
+    zi = signal.sosfilt_zi(sos)[:, :, None] * f0[None, None, :]
+    return FilterState(zi=zi, y1=f0.copy(), y2=f0.copy())
+
+
+def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=None):
+    """Causally low-pass F_A along time (axis 0).
+
+    Parameters
+    ----------
+    f_a : array_like, shape (n_samples, n_afferents)
+        Attenuated force in newtons.
+    fs : float
+        Sample rate in Hz.
+    params : CurrentParams
+        Filter cut-off and order.
+    state : FilterState, optional
+        State carried from the previous chunk; default: steady state at the
+        first sample.
+
+    Returns
+    -------
+    y : ndarray, shape (n_samples, n_afferents)
+        Filtered force in newtons.
+    state : FilterState
+        State after the last sample.
+    """
+    f_a = as_finite_array(f_a, "f_a", ndim=2)
+    if state is None:
+        state = initial_filter_state(f_a[0], fs, params)
+    sos = lowpass_sos(params.cutoff_hz, params.filter_order, fs)
+    y, zi = signal.sosfilt(sos, f_a, axis=0, zi=state.zi)
+    y1 = y[-1] if len(y) >= 1 else state.y1
+    y2 = y[-2] if len(y) >= 2 else (state.y1 if len(y) == 1 else state.y2)
+    return y, FilterState(zi=zi, y1=y1.copy(), y2=y2.copy())
+
+
+def _backward_differences(y, fs, state: FilterState, order: int) -> np.ndarray:
+    """First (order=1) or second (order=2) backward difference, per second^order."""
+    padded = np.concatenate([state.y2[None], state.y1[None], y], axis=0)
+    if order == 1:
+        return (padded[2:] - padded[1:-1]) * fs
+    return (padded[2:] - 2.0 * padded[1:-1] + padded[:-2]) * (fs * fs)
+
+
+def afferent_current(
+    f_a,
+    fs: float,
+    afferent_type: str,
+    params: CurrentParams = CurrentParams(),
+    state: FilterState | None = None,
+):
+    """Input current of afferents of one type (eqs 1-3).
+
+    Parameters
+    ----------
+    f_a : array_like, shape (n_samples, n_afferents)
+        Attenuated force F_A in newtons at sample rate ``fs``.
+    fs : float
+        Sample rate in Hz.
+    afferent_type : {"SAI", "RAI", "RAII"}
+        Which of eqs 1-3 to apply.
+    params : CurrentParams
+        Gains and derivative filter.
+    state : FilterState, optional
+        Filter state carried over from a previous chunk (RAI and RAII only).
+
+    Returns
+    -------
+    current : ndarray, shape (n_samples, n_afferents)
+        Rectified current in mV/ms (Izhikevich units), >= 0.
+    state : FilterState or None
+        Filter state after the chunk (None for SAI, which needs no filter).
+
+    Examples
+    --------
+    >>> f = np.linspace(0.0, 1.0, 1001)[:, None]          # 1 N/s ramp at 1 kHz
+    >>> i, _ = afferent_current(f, 1000.0, "RAI", CurrentParams(g_rai=1.0))
+    >>> round(float(i[-1, 0]), 2)                          # settles at 1 N/s
+    1.0
+    """
+    check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
+    fs = check_positive(fs, "fs", "Hz")
+    f_a = as_finite_array(f_a, "f_a", ndim=2)
+    if afferent_type == "SAI":
+        return params.g_sai * np.abs(f_a), None
+    if state is None:
+        state = initial_filter_state(f_a[0], fs, params) if len(f_a) else None
+    y, new_state = filter_force(f_a, fs, params, state)
+    order = 1 if afferent_type == "RAI" else 2
+    deriv = _backward_differences(y, fs, state, order)
+    return params.gain(afferent_type) * np.abs(deriv), new_state

@@ -1,0 +1,162 @@
+"""The engine seam: one `integrate` call, ``engine="brian2"`` (default) or ``"direct"``.
+
+Both engines take input currents for N afferents and return the spikes as
+(afferent index, step index) pairs, identical between engines.  Currents are
+sampled at ``fs`` and held for ``1 / (fs * dt)`` integration steps, which must
+be a whole number: the input is the same piecewise-constant function of time
+whatever the step, so changing dt changes only the integration error.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._validation import as_finite_array, check_choice, check_positive
+from .neuron import V_PEAK, NeuronParams, neuron_arrays, resting_state
+
+__all__ = ["ENGINES", "METHODS", "NeuronState", "SpikeResult", "substeps_for", "integrate"]
+
+ENGINES = ("brian2", "direct")
+METHODS = ("euler",)
+
+
+@dataclass(frozen=True)
+class NeuronState:
+    """Membrane state of N neurons: ``v`` in mV and ``u`` in mV/ms."""
+
+    v: np.ndarray
+    u: np.ndarray
+
+
+@dataclass(frozen=True)
+class SpikeResult:
+    """Spikes of one `integrate` call.
+
+    Attributes
+    ----------
+    afferent : ndarray of int64
+        Column index of the spiking afferent, one entry per spike.
+    step : ndarray of int64
+        Integration step at whose start the spike is recorded; its time is
+        ``step * dt`` seconds.  Sorted by step, then afferent.
+    state : NeuronState
+        State after the last step (to continue a run).
+    dt : float
+        Step in seconds.
+    n_steps : int
+        Steps integrated.
+    """
+
+    afferent: np.ndarray
+    step: np.ndarray
+    state: NeuronState
+    dt: float
+    n_steps: int
+
+    @property
+    def time(self) -> np.ndarray:
+        """Spike times in seconds."""
+        return self.step * self.dt
+
+    def counts(self, n_afferents: int) -> np.ndarray:
+        """Spike count per afferent."""
+        return np.bincount(self.afferent, minlength=n_afferents)
+
+
+def substeps_for(fs: float, dt: float) -> int:
+    """Integration steps per input sample, ``1 / (fs * dt)``, checked to be whole.
+
+    Examples
+    --------
+    >>> substeps_for(1000.0, 1e-4)
+    10
+    """
+    fs = check_positive(fs, "fs", "Hz")
+    dt = check_positive(dt, "dt", "s")
+    ratio = 1.0 / (fs * dt)
+    n = int(round(ratio))
+    if n < 1 or abs(ratio - n) > 1e-9 * max(1.0, ratio):
+        raise ValueError(
+            f"dt={dt!r} s must divide the sample interval 1/fs = {1.0 / fs!r} s a whole number of times"
+        )
+    return n
+
+
+def _initial_state(state, b, n):
+    if state is None:
+        v, u = resting_state(b)
+        return np.array(v, dtype=float), np.array(u, dtype=float)
+    if not isinstance(state, NeuronState):
+        raise TypeError(f"state must be a NeuronState or None, got {type(state).__name__}")
+    v = as_finite_array(state.v, "state.v", ndim=1).copy()
+    u = as_finite_array(state.u, "state.u", ndim=1).copy()
+    if v.shape != (n,) or u.shape != (n,):
+        raise ValueError(f"state must hold {n} neurons, got v {v.shape} and u {u.shape}")
+    return v, u
+
+
+def integrate(
+    current,
+    *,
+    fs: float,
+    dt: float,
+    afferent_type,
+    engine: str = "brian2",
+    method: str = "euler",
+    state: NeuronState | None = None,
+    neuron_params: dict[str, NeuronParams] | None = None,
+) -> SpikeResult:
+    """Integrate Izhikevich afferents driven by input currents (eqs 4-6).
+
+    Parameters
+    ----------
+    current : array_like, shape (n_samples, n_afferents)
+        Input current in mV/ms (Izhikevich units), sampled at ``fs``.
+    fs : float
+        Sample rate of ``current`` in Hz.
+    dt : float
+        Integration step in seconds; ``1 / (fs * dt)`` must be a whole number.
+    afferent_type : str or sequence of str
+        ``"SAI"``, ``"RAI"`` or ``"RAII"``, one per column or one for all.
+    engine : {"brian2", "direct"}
+        Brian2 C++ standalone (default) or the numba integrator.  Same spikes.
+    method : {"euler"}
+        Integration scheme.
+    state : NeuronState, optional
+        Initial state; default: each neuron's resting fixed point.
+    neuron_params : dict, optional
+        Overrides of `models.neuron.NEURON_PARAMS` by type.
+
+    Returns
+    -------
+    SpikeResult
+
+    Examples
+    --------
+    >>> res = integrate(np.full((100, 1), 10.0), fs=1000.0, dt=1e-4,
+    ...                 afferent_type="SAI", engine="direct")
+    >>> res.counts(1).tolist()
+    [2]
+    """
+    check_choice(engine, "engine", ENGINES)
+    check_choice(method, "method", METHODS)
+    substeps = substeps_for(fs, dt)
+    current = as_finite_array(current, "current", ndim=2)
+    n = current.shape[1]
+    types = np.broadcast_to(np.asarray(afferent_type, dtype=object), (n,))
+    params = neuron_arrays(types, neuron_params)
+    v, u = _initial_state(state, params["b"], n)
+    current = np.ascontiguousarray(current)
+    if n == 0 or current.shape[0] == 0:
+        neuron = step = np.empty(0, np.int64)
+    elif engine == "direct":
+        from .direct import run_direct
+
+        neuron, step = run_direct(current, substeps, dt, params, v, u, method=method, v_peak=V_PEAK)
+    else:
+        from .brian2_engine import run_brian2
+
+        neuron, step = run_brian2(current, substeps, dt, params, v, u, method=method, v_peak=V_PEAK)
+    return SpikeResult(neuron, step, NeuronState(v, u), dt, current.shape[0] * substeps)

@@ -1,0 +1,85 @@
+"""Single-afferent response measures: spiking frequency (SF) and PRSI/DSI (eqs 7, 19)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._validation import as_finite_array, check_positive
+
+__all__ = ["CONTACT_THRESHOLD", "active_mask", "spiking_frequency", "direction_index"]
+
+#: Normal force in newtons above which the finger is "in contact"; SF is
+#: averaged over that active period (paper §IV.C, DDMM-NOTES §1.8).
+CONTACT_THRESHOLD = 0.05
+
+
+def active_mask(fz, threshold: float = CONTACT_THRESHOLD) -> np.ndarray:
+    """Samples in contact: ``F_Z > threshold`` (newtons).
+
+    Examples
+    --------
+    >>> active_mask([0.0, 0.1, 2.0]).tolist()
+    [False, True, True]
+    """
+    return as_finite_array(fz, "fz", ndim=1) > threshold
+
+
+def spiking_frequency(step, n_afferents: int, *, fz, fs: float, substeps: int,
+                      afferent=None, threshold: float = CONTACT_THRESHOLD) -> np.ndarray:
+    """SF in pulses/s: spikes inside the active period divided by its length.
+
+    Parameters
+    ----------
+    step : array_like of int
+        Step index of each spike.
+    n_afferents : int
+        Number of afferents.
+    fz : array_like, shape (n_samples,)
+        Normal force in newtons, at ``fs``.
+    fs : float
+        Force sample rate in Hz.
+    substeps : int
+        Integration steps per force sample.
+    afferent : array_like of int, optional
+        Afferent index of each spike (default: all spikes belong to afferent 0).
+    threshold : float
+        Contact threshold in newtons.
+
+    Returns
+    -------
+    sf : ndarray, shape (n_afferents,)
+        Pulses per second; 0 when the scene has no active period.
+
+    Examples
+    --------
+    >>> spiking_frequency([0, 15], 1, fz=[1.0, 1.0], fs=1000.0, substeps=10).tolist()
+    [1000.0]
+    """
+    active = active_mask(fz, threshold)
+    fs = check_positive(fs, "fs", "Hz")
+    step = np.asarray(step, dtype=np.int64)
+    afferent = np.zeros_like(step) if afferent is None else np.asarray(afferent, dtype=np.int64)
+    inside = active[np.minimum(step // substeps, active.size - 1)]
+    counts = np.bincount(afferent[inside], minlength=n_afferents).astype(float)
+    seconds = active.sum() / fs
+    return counts / seconds if seconds > 0 else np.zeros(n_afferents)
+
+
+def direction_index(r0, r90, r180, r270):
+    """Directional sensitivity index of eq. 7 (DSI), equal to the PRSI of eq. 19.
+
+    ``sqrt((r0 - r180)^2 + (r90 - r270)^2) / (r0 + r90 + r180 + r270)``; the
+    responses may be arrays (one value per afferent).  Where all four are zero
+    the index is 0 (no response carries no direction), never NaN.
+
+    Examples
+    --------
+    >>> float(direction_index(1.0, 3.0, 1.0, 1.0))
+    0.333...
+    """
+    r = [np.asarray(x, dtype=float) for x in (r0, r90, r180, r270)]
+    total = r[0] + r[1] + r[2] + r[3]
+    num = np.hypot(r[0] - r[2], r[1] - r[3])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = np.where(total > 0, num / np.where(total > 0, total, 1.0), 0.0)
+    return out[()] if out.ndim == 0 else out

@@ -1,0 +1,123 @@
+"""Izhikevich neuron parameters per afferent type (paper eqs 4-6).
+
+    dv/dt = 0.04 v^2 + 5 v + 140 - u + I        (eq. 4, t in ms, v in mV)
+    du/dt = A (B v - u)                          (eq. 5)
+    if v >= 30: v <- C, u <- u + D               (eq. 6)
+
+A = 0.02, C = -65, D = 8 for every type.  B = 0.2 for SAI (regular spiking)
+and B = 0.25 for RAI and RAII (low-threshold spiking; the paper's "RAI and
+RAI" is a typo for RAI and RAII, DDMM-NOTES §1.7).  Each neuron starts at
+its resting fixed point for I = 0, not at v = C: an LTS neuron started at
+v = -65, u = B v fires a spurious spike with no input.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._validation import check_choice
+from .currents import AFFERENT_TYPES
+
+__all__ = [
+    "V_PEAK",
+    "NeuronParams",
+    "NEURON_PARAMS",
+    "resting_state",
+    "neuron_arrays",
+]
+
+#: Spike cut-off in mV (eq. 6).
+V_PEAK = 30.0
+
+
+@dataclass(frozen=True)
+class NeuronParams:
+    """Izhikevich parameters of one afferent type (eqs 4-6).
+
+    Attributes
+    ----------
+    a : float
+        Recovery time scale, 1/ms (eq. 5).  Paper: 0.02.
+    b : float
+        Sensitivity of u to v, dimensionless (eq. 5).  0.2 (RS) or 0.25 (LTS).
+    c : float
+        Reset potential in mV (eq. 6).  Paper: -65.
+    d : float
+        Reset increment of u in mV/ms (eq. 6).  Paper: 8.
+    """
+
+    a: float = 0.02
+    b: float = 0.2
+    c: float = -65.0
+    d: float = 8.0
+
+
+#: Parameters per type: SAI regular spiking, RAI and RAII low-threshold spiking.
+NEURON_PARAMS: dict[str, NeuronParams] = {
+    "SAI": NeuronParams(b=0.2),
+    "RAI": NeuronParams(b=0.25),
+    "RAII": NeuronParams(b=0.25),
+}
+
+
+def resting_state(b) -> tuple[np.ndarray, np.ndarray]:
+    """Resting fixed point (v_rest, u_rest) of eqs 4-5 for I = 0.
+
+    v_rest is the lower root of ``0.04 v^2 + (5 - b) v + 140 = 0`` and
+    ``u_rest = b v_rest``.
+
+    Parameters
+    ----------
+    b : float or array_like
+        Parameter B of eq. 5.
+
+    Returns
+    -------
+    v_rest, u_rest : ndarray
+        In mV and mV/ms.
+
+    Examples
+    --------
+    >>> v, u = resting_state(0.2)
+    >>> round(float(v), 6), round(float(u), 6)
+    (-70.0, -14.0)
+    """
+    b = np.asarray(b, dtype=float)
+    disc = (5.0 - b) ** 2 - 4.0 * 0.04 * 140.0
+    if np.any(disc < 0.0):
+        raise ValueError(f"b={b!r} leaves eq. 4-5 without a resting state (b must be <= 0.267)")
+    v = (-(5.0 - b) - np.sqrt(disc)) / (2.0 * 0.04)
+    return v, b * v
+
+
+def neuron_arrays(afferent_type, params: dict[str, NeuronParams] | None = None):
+    """Per-afferent parameter arrays for a sequence of afferent types.
+
+    Parameters
+    ----------
+    afferent_type : str or sequence of str
+        ``"SAI"``, ``"RAI"`` or ``"RAII"`` per afferent.
+    params : dict, optional
+        Overrides of `NEURON_PARAMS`, keyed by type.
+
+    Returns
+    -------
+    dict
+        Arrays ``a``, ``b``, ``c``, ``d`` (float64, one entry per afferent).
+
+    Examples
+    --------
+    >>> neuron_arrays(["SAI", "RAI"])["b"].tolist()
+    [0.2, 0.25]
+    """
+    table = dict(NEURON_PARAMS, **(params or {}))
+    types = np.atleast_1d(np.asarray(afferent_type, dtype=object))
+    for t in np.unique(types):
+        check_choice(t, "afferent_type", AFFERENT_TYPES)
+    out = {}
+    for field in ("a", "b", "c", "d"):
+        lookup = {t: getattr(table[t], field) for t in AFFERENT_TYPES}
+        out[field] = np.array([lookup[t] for t in types], dtype=float)
+    return out

@@ -1,0 +1,233 @@
+"""Scenes: three-axis fingertip force on a uniform time base.
+
+Frame: +X radial, +Y distal, +Z into the skin (normal force >= 0), so a shear
+direction theta = 0 deg is radial, 90 deg distal, 180 deg ulnar and 270 deg
+proximal.  Forces are in newtons, times in seconds, positions in mm.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from models._validation import as_finite_array, check_positive
+
+__all__ = [
+    "DEFAULT_FS",
+    "Contact",
+    "Stage",
+    "Scene",
+    "birznieks",
+    "press_push_lift",
+    "rotating_shear",
+]
+
+#: Default force sample rate in Hz: 50x the 20 Hz derivative cut-off.
+DEFAULT_FS = 1000.0
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Contact geometry on the fingertip: centre (mm, fingertip frame) and radius (mm)."""
+
+    x_mm: float
+    y_mm: float
+    radius_mm: float
+
+    def __post_init__(self):
+        for name in ("x_mm", "y_mm"):
+            value = getattr(self, name)
+            if not np.isfinite(value):
+                raise ValueError(f"contact {name} must be finite, got {value!r}")
+        check_positive(self.radius_mm, "contact radius_mm", "mm")
+
+
+@dataclass(frozen=True)
+class Stage:
+    """A labelled interval [start, end) of a scene, in seconds."""
+
+    label: str
+    start: float
+    end: float
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """Three-axis force sampled uniformly at ``fs``.
+
+    Attributes
+    ----------
+    fx, fy, fz : ndarray, shape (n_samples,)
+        Force in newtons: shear (+X radial, +Y distal) and normal (>= 0).
+    fs : float
+        Sample rate in Hz; sample i is at ``i / fs`` seconds.
+    name : str
+        Condition name (used as the dataset's ``condition`` label).
+    stages : tuple of Stage
+        Labelled phases, e.g. loading, plateau, unloading.
+    contact : Contact or None
+        Where the force is applied; None means no spatial information.
+    theta_r : float or None
+        Nominal shear direction in degrees, when the scene has one.
+    """
+
+    fx: np.ndarray
+    fy: np.ndarray
+    fz: np.ndarray
+    fs: float = DEFAULT_FS
+    name: str = "scene"
+    stages: tuple = field(default_factory=tuple)
+    contact: Contact | None = None
+    theta_r: float | None = None
+
+    def __post_init__(self):
+        arrays = [as_finite_array(getattr(self, n), n, ndim=1) for n in ("fx", "fy", "fz")]
+        if not (arrays[0].size == arrays[1].size == arrays[2].size):
+            raise ValueError(
+                "fx, fy and fz must have equal length; got "
+                f"{arrays[0].size}, {arrays[1].size} and {arrays[2].size}"
+            )
+        if arrays[0].size == 0:
+            raise ValueError("a scene needs at least one force sample, got 0")
+        if np.any(arrays[2] < 0):
+            i = int(np.flatnonzero(arrays[2] < 0)[0])
+            raise ValueError(f"fz must be >= 0 N (compressive); got {arrays[2][i]!r} at t = {i / self.fs} s")
+        check_positive(self.fs, "fs", "Hz")
+        if self.contact is not None and not isinstance(self.contact, Contact):
+            raise TypeError(f"contact must be a Contact or None, got {type(self.contact).__name__}")
+        for n, a in zip(("fx", "fy", "fz"), arrays):
+            a.setflags(write=False)
+            object.__setattr__(self, n, a)
+        object.__setattr__(self, "stages", tuple(self.stages))
+
+    @property
+    def n_samples(self) -> int:
+        """Number of force samples."""
+        return self.fz.size
+
+    @property
+    def duration(self) -> float:
+        """Length in seconds (``n_samples / fs``)."""
+        return self.n_samples / self.fs
+
+    @property
+    def time(self) -> np.ndarray:
+        """Sample times in seconds."""
+        return np.arange(self.n_samples) / self.fs
+
+    def max_shear(self) -> float:
+        """Largest shear magnitude in newtons."""
+        return float(np.max(np.hypot(self.fx, self.fy)))
+
+
+def _samples(duration: float, fs: float) -> np.ndarray:
+    n = int(round(duration * fs))
+    return np.arange(n) / fs
+
+
+def birznieks(direction_deg: float | None = 90.0, *, normal_n: float = 4.0, angle_deg: float = 20.0,
+              ramp_s: float = 0.125, hold_s: float = 0.25, fs: float = DEFAULT_FS,
+              contact: Contact | None = None) -> Scene:
+    """Ramp-hold-release of Birznieks et al. 2001 (paper Fig. 6a, DDMM-NOTES §1.9).
+
+    0-0.125 s loading ramp, 0.125-0.375 s plateau, 0.375-0.5 s unloading.
+    The normal force rises to ``normal_n`` (4 N); the tangential force to
+    ``normal_n * tan(angle_deg)`` (about 1.456 N) in direction
+    ``direction_deg``, so the force is inclined 20 deg from the normal.
+
+    Parameters
+    ----------
+    direction_deg : float or None
+        Shear direction theta_R in degrees (0 radial, 90 distal, 180 ulnar,
+        270 proximal); None gives the normal-only condition.
+    normal_n, angle_deg, ramp_s, hold_s, fs, contact
+        Normal force (N), inclination (deg), ramp and plateau lengths (s),
+        sample rate (Hz) and optional contact geometry.
+
+    Examples
+    --------
+    >>> s = birznieks(90.0)
+    >>> round(float(s.fy.max()), 3), s.duration
+    (1.456, 0.5)
+    """
+    t = _samples(2 * ramp_s + hold_s, fs)
+    knots = [0.0, ramp_s, ramp_s + hold_s, 2 * ramp_s + hold_s]
+    profile = np.interp(t, knots, [0.0, 1.0, 1.0, 0.0])
+    fz = normal_n * profile
+    if direction_deg is None:
+        fx = fy = np.zeros_like(fz)
+        name = "normal"
+    else:
+        shear = normal_n * np.tan(np.deg2rad(angle_deg)) * profile
+        rad = np.deg2rad(direction_deg)
+        fx, fy = shear * np.cos(rad), shear * np.sin(rad)
+        name = f"birznieks_{direction_deg:g}"
+    stages = (Stage("loading", 0.0, knots[1]), Stage("plateau", knots[1], knots[2]),
+              Stage("unloading", knots[2], knots[3]))
+    return Scene(fx, fy, fz, fs, name, stages, contact, direction_deg)
+
+
+def press_push_lift(theta_r: float = 90.0, *, press_n: float = 3.0, push_n: float = 6.0,
+                    shear_n: float | None = None, ramp_s: float = 2.0, fs: float = DEFAULT_FS,
+                    contact: Contact | None = None) -> Scene:
+    """Press-push-lift of paper §IV.B (Fig. 7a), with documented choices.
+
+    * 0-5 s: no contact.
+    * Stage 1 (5-15 s): ramp F_Z to ``press_n`` (3 N) over ``ramp_s``, hold.
+    * Stage 2 (15-25 s): ramp F_Z to ``push_n`` (6 N) and the shear to
+      ``shear_n`` in direction ``theta_r`` over ``ramp_s``, hold.  The default
+      shear is ``push_n * tan 20 deg`` (about 2.18 N), Birznieks' inclination.
+    * Stage 3 (25-30 s): ramp everything to 0 over ``ramp_s`` (lift), rest.
+
+    Each stage is a dynamic period (D, the ramp) then a static one (S).
+
+    Examples
+    --------
+    >>> s = press_push_lift()
+    >>> s.duration, round(float(s.fz.max()), 1)
+    (30.0, 6.0)
+    """
+    shear_n = push_n * np.tan(np.deg2rad(20.0)) if shear_n is None else shear_n
+    t = _samples(30.0, fs)
+    knots = [0.0, 5.0, 5.0 + ramp_s, 15.0, 15.0 + ramp_s, 25.0, 25.0 + ramp_s, 30.0]
+    fz = np.interp(t, knots, [0, 0, press_n, press_n, push_n, push_n, 0, 0])
+    shear = np.interp(t, knots, [0, 0, 0, 0, shear_n, shear_n, 0, 0])
+    rad = np.deg2rad(theta_r)
+    stages = tuple(
+        Stage(label, a, b) for label, a, b in (
+            ("stage1_dynamic", 5.0, 5.0 + ramp_s), ("stage1_static", 5.0 + ramp_s, 15.0),
+            ("stage2_dynamic", 15.0, 15.0 + ramp_s), ("stage2_static", 15.0 + ramp_s, 25.0),
+            ("stage3_dynamic", 25.0, 25.0 + ramp_s), ("stage3_static", 25.0 + ramp_s, 30.0),
+        )
+    )
+    return Scene(shear * np.cos(rad), shear * np.sin(rad), fz, fs, f"press_push_lift_{theta_r:g}",
+                 stages, contact, theta_r)
+
+
+def rotating_shear(*, normal_n: float = 4.0, shear_n: float = 1.456, period_s: float = 2.0,
+                   start_deg: float = 0.0, turns: float = 1.0, ramp_s: float = 0.125,
+                   fs: float = DEFAULT_FS, contact: Contact | None = None) -> Scene:
+    """Constant normal force with a shear direction rotating counter-clockwise.
+
+    The normal force and shear ramp up over ``ramp_s`` with the direction
+    fixed at ``start_deg``, then the direction turns at ``360 / period_s``
+    deg/s for ``turns`` turns, then everything ramps down: a stimulus for
+    continuous direction decoding.
+
+    Examples
+    --------
+    >>> s = rotating_shear(period_s=1.0)
+    >>> round(s.duration, 3)
+    1.25
+    """
+    rotate_s = period_s * turns
+    t = _samples(2 * ramp_s + rotate_s, fs)
+    knots = [0.0, ramp_s, ramp_s + rotate_s, 2 * ramp_s + rotate_s]
+    envelope = np.interp(t, knots, [0.0, 1.0, 1.0, 0.0])
+    angle = np.deg2rad(start_deg) + 2 * np.pi * np.clip(t - ramp_s, 0.0, rotate_s) / period_s
+    shear = shear_n * envelope
+    stages = (Stage("loading", 0.0, ramp_s), Stage("rotation", ramp_s, ramp_s + rotate_s),
+              Stage("unloading", ramp_s + rotate_s, knots[-1]))
+    return Scene(shear * np.cos(angle), shear * np.sin(angle), normal_n * envelope, fs,
+                 "rotating_shear", stages, contact, None)
