@@ -1,0 +1,1 @@
+"""Reproductions, biology comparisons, calibration, benchmarks and the ddmm CLI."""

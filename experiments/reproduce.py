@@ -17,34 +17,21 @@ from models.metrics import direction_index, spiking_frequency
 from models.pipeline import compute_currents
 from population.scenes import Scene, birznieks, press_push_lift
 
+
 __all__ = [
     "PROFILES",
-    "PAPER_TABLE2",
-    "PAPER_TABLE3",
     "ReproConfig",
     "scene_sf",
     "table2",
     "table3",
     "fig8",
     "reproduce_all",
+    "response_data",
+    "FIGURE_SCENES",
 ]
 
 #: Profiles in the reproductions; "cmm" is the conventional model (AF = 1).
 PROFILES = ("selective", "broad", "bipolar", "cmm")
-#: Paper Table II: PRSI at theta_R = 90 deg, k = 3.
-PAPER_TABLE2 = {
-    "selective": {"SAI": 0.38, "RAI": 0.31, "RAII": 0.33},
-    "broad": {"SAI": 0.45, "RAI": 0.36, "RAII": 0.33},
-    "bipolar": {"SAI": 0.0, "RAI": 0.0, "RAII": 0.0},
-    "cmm": {"SAI": 0.0, "RAI": 0.0, "RAII": 0.0},
-}
-#: Paper Table III: SF in pulses/s at theta_T = 75 / 255 deg (press-push-lift).
-PAPER_TABLE3 = {
-    "selective": {"SAI": (37.5, 15.0), "RAI": (17.5, 7.5), "RAII": (15.0, 7.5)},
-    "broad": {"SAI": (47.5, 10.0), "RAI": (20.0, 7.5), "RAII": (20.0, 7.5)},
-    "bipolar": {"SAI": (37.5, 37.5), "RAI": (17.5, 17.5), "RAII": (15.0, 15.0)},
-    "cmm": {"SAI": (47.5, 47.5), "RAI": (15.0, 15.0), "RAII": (10.0, 10.0)},
-}
 FIG8_ANGLES = tuple(range(0, 360, 15))
 
 
@@ -154,3 +141,38 @@ def reproduce_all(config: ReproConfig = ReproConfig()) -> dict:
     sf = _press_push_lift_sf(angles, config)
     sub = {p: {t: sf[p][t][[angles.index(75.0), angles.index(255.0)]] for t in AFFERENT_TYPES} for p in sf}
     return {"table2": table2(config), "table3": table3(config, sub), "fig8": fig8(config, sf)}
+
+
+def response_data(scene: Scene, profile: str, angles, config: ReproConfig = ReproConfig()) -> dict:
+    """Data for a Fig. 6/7 panel: forces, AF(t) and spike times per type and theta_T.
+
+    Parameters
+    ----------
+    scene : Scene
+        The stimulus.
+    profile : str
+        A profile of `PROFILES`.
+    angles : sequence of (label, theta_T in deg)
+        Conditions, e.g. ``[("aligned", 90.0), ("misaligned", 180.0)]``.
+    """
+    from models.attenuation import attenuation_factor
+
+    thetas = [a for _, a in angles]
+    _, result = scene_sf(scene, thetas, config, profiles=(profile,))
+    af = attenuation_factor(scene.fx, scene.fy, thetas, _model_profile(profile), config.k,
+                            no_shear=config.no_shear)
+    conditions = []
+    for j, (label, theta) in enumerate(angles):
+        spikes = {kind: result.time[result.afferent == i * len(angles) + j]
+                  for i, kind in enumerate(AFFERENT_TYPES)}
+        conditions.append({"label": f"{profile}, {label} (theta_T = {theta:g} deg)",
+                           "af": af[:, j], "spikes": spikes})
+    return {"time": scene.time, "forces": {"fx": scene.fx, "fy": scene.fy, "fz": scene.fz},
+            "conditions": conditions}
+
+
+#: Conditions of paper Figs 6 (Birznieks scene) and 7 (press-push-lift).
+FIGURE_SCENES = {
+    "fig6": (lambda: birznieks(90.0), (("aligned", 90.0), ("misaligned", 180.0))),
+    "fig7": (lambda: press_push_lift(90.0), (("near-aligned", 75.0), ("near-misaligned", 255.0))),
+}

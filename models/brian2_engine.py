@@ -128,9 +128,11 @@ def _build(key: tuple) -> _Build:
             flush=True,
         )
     with _brian2_prefs() as b2:
-        b2.device.reinit()
-        b2.device.activate(directory=str(directory), build_on_run=False)
-        b2.set_device("cpp_standalone", directory=str(directory), build_on_run=False)
+        from brian2.devices.device import all_devices
+
+        standalone = all_devices["cpp_standalone"]  # one singleton per process
+        standalone.reinit()  # forget the previously built project, if any
+        b2.set_device(standalone, directory=str(directory), build_on_run=False)
         fs = 1.0 / (dt * substeps)
         ta = b2.TimedArray(np.zeros((n_samples, n_neurons)), dt=(1.0 / fs) * b2.second, name="ddmm_current")
         group = b2.NeuronGroup(
@@ -153,10 +155,10 @@ def _build(key: tuple) -> _Build:
         monitor = b2.SpikeMonitor(group, name="spikes")
         net = b2.Network(group, monitor)
         net.run(n_samples * substeps * dt * b2.second, namespace={"ddmm_current": ta, "ms": b2.ms})
-        device = b2.get_device()
-        device.build(directory=str(directory), run=False, with_output=False)
+        standalone.build(directory=str(directory), run=False, with_output=False)
         b2.set_device("runtime")  # leave the user's Brian2 in its default mode
-    return _Build(key, directory, group, monitor, ta, device, n_neurons, n_samples, n_samples * substeps * dt)
+    return _Build(key, directory, group, monitor, ta, standalone, n_neurons, n_samples,
+                  n_samples * substeps * dt)
 
 
 def _activate(key: tuple) -> _Build:

@@ -4,6 +4,13 @@
 * RAI its rate of change:       ``I = g_rai * |dF_A/dt|``       (eq. 2)
 * RAII its acceleration:        ``I = g_raii * |d^2F_A/dt^2|``  (eq. 3)
 
+By default the drive is used as is (the paper's linear eqs).  An optional
+compressive transducer ``I = i_sat * log1p(x / i_sat)`` bounds the rates on
+fast ramps: with the Table III gains, Birznieks' 32 N/s ramp drives RAI to
+~1.8 kHz and RAII to one spike per step in 10 ms bins, because the
+Izhikevich rate grows ~2.2 Hz per unit current without bound.  The README
+("Model") records the measured trade-off.
+
 Derivatives of a raw force signal are useless (DDMM-NOTES §1.6), so F_A is
 low-passed first by a *causal* Butterworth filter and differentiated by
 backward differences.  Both keep explicit state (`FilterState`), so a signal
@@ -60,17 +67,24 @@ class CurrentParams:
         aligned > misaligned ordering for RAII).
     filter_order : int
         Order of that Butterworth filter (2 in the notes' trial).
+    i_sat : float or None
+        Scale of the compressive transducer in mV/ms:
+        ``I = i_sat * log1p(g * x / i_sat)``, about ``g * x`` while
+        ``g * x << i_sat``.  None: the paper's linear eqs 1-3 verbatim.
     """
 
     g_sai: float = 5.367  # fitted: CMM SAI SF 47.5 pulses/s (Table III)
-    g_rai: float = 11.035  # fitted: CMM RAI SF 15 pulses/s (Table III)
-    g_raii: float = 6.157  # fitted: CMM RAII SF 10 pulses/s (Table III)
+    g_rai: float = 11.036  # fitted: CMM RAI SF 15 pulses/s (Table III)
+    g_raii: float = 6.162  # fitted: CMM RAII SF 10 pulses/s (Table III)
     cutoff_hz: float = 20.0
     filter_order: int = 2
+    i_sat: float | None = None
 
     def __post_init__(self):
         for name in ("g_sai", "g_rai", "g_raii", "cutoff_hz"):
             check_positive(getattr(self, name), name)
+        if self.i_sat is not None:
+            check_positive(self.i_sat, "i_sat", "mV/ms")
         if not isinstance(self.filter_order, int) or not 1 <= self.filter_order <= 8:
             raise ValueError(f"filter_order must be an int in [1, 8], got {self.filter_order!r}")
 
@@ -84,15 +98,21 @@ class CurrentParams:
 class FilterState:
     """State of the causal low-pass and backward differences between chunks.
 
+    The filter runs on the deviation from ``offset`` (the first sample), so a
+    constant force is filtered exactly and gives exactly zero RAI/RAII current.
+
     Attributes
     ----------
     zi : ndarray, shape (n_sections, 2, n_afferents)
         Second-order-section state of `scipy.signal.sosfilt`.
+    offset : ndarray, shape (n_afferents,)
+        Force subtracted before filtering, in newtons.
     y1, y2 : ndarray, shape (n_afferents,)
-        The last and second-to-last filtered samples, in newtons.
+        The last and second-to-last filtered deviations, in newtons.
     """
 
     zi: np.ndarray
+    offset: np.ndarray
     y1: np.ndarray
     y2: np.ndarray
 
@@ -119,16 +139,24 @@ def _butter_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
 
 
 def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams()) -> FilterState:
-    """Filter state at steady state for a constant input ``f0`` (newtons).
+    """Filter state at rest on a constant input ``f0`` (newtons).
 
     Starting at steady state means a trace that begins mid-contact produces
     no spurious derivative at its first sample; a trace that starts at rest
     (F_A = 0) is unaffected.
     """
-    f0 = np.atleast_1d(np.asarray(f0, dtype=float))
+    f0 = np.atleast_1d(np.asarray(f0, dtype=float)).copy()
     sos = lowpass_sos(params.cutoff_hz, params.filter_order, fs)
-    zi = signal.sosfilt_zi(sos)[:, :, None] * f0[None, None, :]
-    return FilterState(zi=zi, y1=f0.copy(), y2=f0.copy())
+    zeros = np.zeros_like(f0)
+    return FilterState(zi=np.zeros((sos.shape[0], 2, f0.size)), offset=f0, y1=zeros, y2=zeros.copy())
+
+
+def _filter_deviation(f_a, fs, params, state: FilterState):
+    """Low-passed deviation from ``state.offset`` and the state after it."""
+    sos = lowpass_sos(params.cutoff_hz, params.filter_order, fs)
+    dev, zi = signal.sosfilt(sos, f_a - state.offset, axis=0, zi=state.zi)
+    history = np.concatenate([state.y2[None], state.y1[None], dev], axis=0)
+    return dev, FilterState(zi=zi, offset=state.offset, y1=history[-1].copy(), y2=history[-2].copy())
 
 
 def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=None):
@@ -143,8 +171,8 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
     params : CurrentParams
         Filter cut-off and order.
     state : FilterState, optional
-        State carried from the previous chunk; default: steady state at the
-        first sample.
+        State carried from the previous chunk; default: at rest on the first
+        sample.
 
     Returns
     -------
@@ -156,16 +184,13 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
     f_a = as_finite_array(f_a, "f_a", ndim=2)
     if state is None:
         state = initial_filter_state(f_a[0], fs, params)
-    sos = lowpass_sos(params.cutoff_hz, params.filter_order, fs)
-    y, zi = signal.sosfilt(sos, f_a, axis=0, zi=state.zi)
-    y1 = y[-1] if len(y) >= 1 else state.y1
-    y2 = y[-2] if len(y) >= 2 else (state.y1 if len(y) == 1 else state.y2)
-    return y, FilterState(zi=zi, y1=y1.copy(), y2=y2.copy())
+    dev, new_state = _filter_deviation(f_a, fs, params, state)
+    return dev + state.offset, new_state
 
 
-def _backward_differences(y, fs, state: FilterState, order: int) -> np.ndarray:
+def _backward_differences(dev, fs, state: FilterState, order: int) -> np.ndarray:
     """First (order=1) or second (order=2) backward difference, per second^order."""
-    padded = np.concatenate([state.y2[None], state.y1[None], y], axis=0)
+    padded = np.concatenate([state.y2[None], state.y1[None], dev], axis=0)
     if order == 1:
         return (padded[2:] - padded[1:-1]) * fs
     return (padded[2:] - 2.0 * padded[1:-1] + padded[:-2]) * (fs * fs)
@@ -211,10 +236,17 @@ def afferent_current(
     fs = check_positive(fs, "fs", "Hz")
     f_a = as_finite_array(f_a, "f_a", ndim=2)
     if afferent_type == "SAI":
-        return params.g_sai * np.abs(f_a), None
+        return _saturate(params.g_sai * np.abs(f_a), params), None
     if state is None:
-        state = initial_filter_state(f_a[0], fs, params) if len(f_a) else None
-    y, new_state = filter_force(f_a, fs, params, state)
+        state = initial_filter_state(f_a[0], fs, params)
+    dev, new_state = _filter_deviation(f_a, fs, params, state)
     order = 1 if afferent_type == "RAI" else 2
-    deriv = _backward_differences(y, fs, state, order)
-    return params.gain(afferent_type) * np.abs(deriv), new_state
+    deriv = _backward_differences(dev, fs, state, order)
+    return _saturate(params.gain(afferent_type) * np.abs(deriv), params), new_state
+
+
+def _saturate(drive, params: CurrentParams):
+    """Compressive transduction of the linear drive (see the module docstring)."""
+    if params.i_sat is not None:
+        drive = params.i_sat * np.log1p(drive / params.i_sat)
+    return drive

@@ -138,7 +138,7 @@ def integrate(
     >>> res = integrate(np.full((100, 1), 10.0), fs=1000.0, dt=1e-4,
     ...                 afferent_type="SAI", engine="direct")
     >>> res.counts(1).tolist()
-    [2]
+    [3]
     """
     check_choice(engine, "engine", ENGINES)
     check_choice(method, "method", METHODS)

@@ -1,0 +1,1 @@
+"""Populations of afferents: scenes, specs, sampling, simulation, datasets, decoding."""

@@ -1,0 +1,42 @@
+"""The ``ddmm`` command line.  Bad input ends with a one-line error and exit status 2."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+__all__ = ["build_parser", "main"]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser with every subcommand registered."""
+    from . import cmd_reproduce
+
+    parser = argparse.ArgumentParser(
+        prog="ddmm",
+        description="Population-coding simulator of tactile afferents (DDMM).",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for module in (cmd_reproduce,):
+        module.register(sub)
+    return parser
+
+
+def main(argv=None) -> int:
+    """Entry point of the ``ddmm`` console script."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except (ValueError, TypeError) as exc:
+        print(f"ddmm: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        print(f"ddmm: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "), file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("ddmm: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

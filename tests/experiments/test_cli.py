@@ -1,0 +1,59 @@
+"""The ddmm CLI: reproduce output, engine-identical JSON, figures, errors with exit 2."""
+
+import json
+
+import pytest
+
+from experiments.cli import main
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_engines_print_identical_json(capsys):
+    outputs = []
+    for engine in ("direct", "brian2"):
+        code, out, _ = run(capsys, "reproduce", "all", "--json", "--engine", engine)
+        assert code == 0
+        outputs.append(out)
+    assert outputs[0] == outputs[1]
+    assert set(json.loads(outputs[0])) == {"table2", "table3", "fig8"}
+
+
+@pytest.mark.parametrize("what,key", [("table2", "prsi"), ("table3", "sf"), ("fig8", "sf")])
+def test_json_per_table(capsys, what, key):
+    code, out, _ = run(capsys, "reproduce", what, "--json", "--engine", "direct", "--no-shear", "block")
+    assert code == 0 and list(json.loads(out)) == [key]
+
+
+def test_tables_and_figures_written(capsys, tmp_path):
+    code, out, _ = run(capsys, "reproduce", "all", "--engine", "direct", "--out", str(tmp_path))
+    assert code == 0
+    assert "Table II" in out and "0.38" in out and "Table III" in out
+    names = {p.name for p in tmp_path.iterdir()}
+    expected = {"fig8.png", "reproduce.json"} | {f"fig{n}_{p}.png" for n in (6, 7)
+                                                 for p in ("selective", "broad", "bipolar", "cmm")}
+    assert expected <= names
+    assert all((tmp_path / n).stat().st_size > 10_000 for n in expected if n.endswith(".png"))
+    assert not [n for n in names if n.endswith(".part")]
+
+
+@pytest.mark.parametrize("argv", [
+    ["reproduce", "table9"], ["reproduce", "all", "--engine", "nest"],
+    ["reproduce", "all", "--no-shear", "maybe"],
+])
+def test_bad_arguments_exit_2(capsys, argv):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+
+
+def test_unwritable_out_is_one_line_error(capsys, tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    code, out, err = run(capsys, "reproduce", "table2", "--engine", "direct", "--out", str(blocker / "d"))
+    assert code == 2
+    assert err.startswith("ddmm: error:") and err.count("\n") == 1 and "Traceback" not in err

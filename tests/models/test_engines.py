@@ -1,0 +1,107 @@
+"""The engine seam: both engines give identical spikes, and zero input stays silent."""
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
+
+from models.engines import NeuronState, integrate, substeps_for
+from models.pipeline import simulate
+from tests.conftest import ENGINES
+
+TYPES = ("SAI", "RAI", "RAII")
+
+
+def spikes(res):
+    return list(zip(res.afferent.tolist(), res.step.tolist()))
+
+
+@given(current=hnp.arrays(np.float64, st.tuples(st.integers(1, 200), st.integers(1, 30)),
+                          elements=st.floats(-20.0, 250.0, allow_subnormal=False)),
+       seed=st.integers(0, 2**16))
+def test_engines_identical_on_random_currents(current, seed):
+    types = np.random.default_rng(seed).choice(TYPES, current.shape[1])
+    a = integrate(current, fs=1000.0, dt=1e-4, afferent_type=types, engine="direct")
+    b = integrate(current, fs=1000.0, dt=1e-4, afferent_type=types, engine="brian2")
+    assert spikes(a) == spikes(b)
+    np.testing.assert_array_equal(a.state.v, b.state.v)
+    np.testing.assert_array_equal(a.state.u, b.state.u)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_continuing_from_state_equals_one_run(engine):
+    rng = np.random.default_rng(3)
+    current = rng.uniform(0, 40, (600, 5))
+    whole = integrate(current, fs=1000.0, dt=1e-4, afferent_type="RAI", engine=engine)
+    first = integrate(current[:230], fs=1000.0, dt=1e-4, afferent_type="RAI", engine=engine)
+    second = integrate(current[230:], fs=1000.0, dt=1e-4, afferent_type="RAI", engine=engine,
+                       state=first.state)
+    joined = spikes(first) + [(a, s + 2300) for a, s in spikes(second)]
+    assert joined == spikes(whole)
+    np.testing.assert_array_equal(second.state.v, whole.state.v)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_ten_seconds_of_zero_force_give_no_spikes(engine):
+    n = 10_000
+    zeros = np.zeros(n)
+    for profile in ("selective", "broad", "bipolar", "none"):
+        res = simulate(zeros, zeros, zeros, fs=1000.0, afferent_type=list(TYPES), profile=profile,
+                       theta_t=[0.0, 90.0, 180.0], engine=engine)
+        assert res.afferent.size == 0
+        assert res.n_steps == n * 10
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_neurons_start_at_rest(engine):
+    res = integrate(np.zeros((300, 3)), fs=1000.0, dt=1e-4, afferent_type=list(TYPES), engine=engine)
+    np.testing.assert_allclose(res.state.v, [-70.0, -64.41391, -64.41391], atol=1e-4)
+
+
+def test_brian2_compiles_once_per_shape(capsys):
+    rng = np.random.default_rng(0)
+    for _ in range(3):  # same shape, new values: no compile notice after the first
+        integrate(rng.uniform(0, 20, (90, 7)), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")
+    first = capsys.readouterr().err
+    integrate(rng.uniform(0, 20, (90, 7)), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")
+    assert "compiling" not in capsys.readouterr().err
+    assert first.count("compiling") <= 1
+
+
+def test_substeps_must_be_whole():
+    assert substeps_for(1000.0, 1e-5) == 100
+    with pytest.raises(ValueError, match="dt"):
+        substeps_for(1000.0, 3e-4)
+
+
+@pytest.mark.parametrize("kwargs,exc,match", [
+    (dict(fs=0.0), ValueError, "fs"),
+    (dict(dt=-1e-4), ValueError, "dt"),
+    (dict(dt=0.0), ValueError, "dt"),
+    (dict(engine="neuron"), ValueError, "engine"),
+    (dict(method="rk9"), ValueError, "method"),
+    (dict(afferent_type="SAII"), ValueError, "afferent_type"),
+    (dict(state=(1, 2)), TypeError, "state"),
+    (dict(state=NeuronState(np.zeros(2), np.zeros(2))), ValueError, "state"),
+])
+def test_bad_input(kwargs, exc, match):
+    args = dict(fs=1000.0, dt=1e-4, afferent_type="SAI", engine="direct")
+    args.update(kwargs)
+    with pytest.raises(exc, match=match):
+        integrate(np.zeros((10, 3)), **args)
+    with pytest.raises(ValueError, match="current"):
+        integrate(np.full((10, 3), np.nan), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="direct")
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    (dict(fx=[0.0, np.nan]), "fx"), (dict(fz=[0.0, np.inf]), "fz"),
+    (dict(fy=[0.0]), "equal length"), (dict(fz=[0.0, -1.0]), "fz"),
+    (dict(profile="oval"), "profile"), (dict(k=0.0), "k="), (dict(profile="broad", k=1.5), "k="),
+])
+def test_pipeline_bad_input(kwargs, match):
+    args = dict(fx=[0.0, 0.0], fy=[0.0, 0.0], fz=[0.0, 1.0], fs=1000.0, afferent_type="SAI",
+                profile="selective", k=3.0, engine="direct")
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=match):
+        simulate(args.pop("fx"), args.pop("fy"), args.pop("fz"), **args)

@@ -1,0 +1,28 @@
+"""Every public example in a numpydoc docstring runs and prints what it shows."""
+
+import doctest
+import importlib
+import pkgutil
+
+import pytest
+
+PACKAGES = ("models", "population", "experiments")
+
+
+def _modules():
+    for name in PACKAGES:
+        pkg = importlib.import_module(name)
+        yield name
+        for info in pkgutil.walk_packages(pkg.__path__, prefix=f"{name}."):
+            yield info.name
+
+
+@pytest.mark.parametrize("module_name", sorted(_modules()))
+def test_docstring_examples(module_name):
+    module = importlib.import_module(module_name)
+    finder = doctest.DocTestFinder(exclude_empty=True)
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    for test in finder.find(module, module_name, extraglobs={"np": __import__("numpy")}):
+        runner.run(test)
+    result = runner.summarize(verbose=False)
+    assert result.failed == 0, f"{result.failed} docstring example(s) failed in {module_name}"
