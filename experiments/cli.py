@@ -8,15 +8,23 @@ import sys
 __all__ = ["build_parser", "main"]
 
 
+class _Parser(argparse.ArgumentParser):
+    """An ArgumentParser whose usage errors are one line and exit status 2."""
+
+    def error(self, message):
+        self.exit(2, f"ddmm: error: {message} (see '{self.prog} --help')\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand registered."""
     from . import cmd_reproduce
 
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="ddmm",
         description="Population-coding simulator of tactile afferents (DDMM).",
     )
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
+                                parser_class=_Parser)
     for module in (cmd_reproduce,):
         module.register(sub)
     return parser

@@ -49,6 +49,8 @@ def test_bad_arguments_exit_2(capsys, argv):
     with pytest.raises(SystemExit) as exc:
         main(argv)
     assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("ddmm: error:") and err.count("\n") == 1
 
 
 def test_unwritable_out_is_one_line_error(capsys, tmp_path):
