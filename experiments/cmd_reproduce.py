@@ -7,7 +7,6 @@ import json
 from models.currents import AFFERENT_TYPES
 
 from .io import ensure_out_dir, save_figure, save_json
-from .plotting import plot_response, plot_sf_vs_theta
 from .reference import PAPER_TABLE2, PAPER_TABLE3
 from .reproduce import (FIGURE_SCENES, PROFILES, ReproConfig, fig8, reproduce_all, response_data,
                         table2, table3)
@@ -71,6 +70,8 @@ def format_fig8(result: dict) -> str:
 
 
 def _write_figures(out_dir, what, config, result) -> list[str]:
+    from .plotting import plot_response, plot_sf_vs_theta  # matplotlib is slow to import
+
     written = []
     if what in ("fig8", "all"):
         sf = result["fig8"]["sf"] if what == "all" else result["sf"]

@@ -10,7 +10,7 @@ from matplotlib.figure import Figure
 
 from models.currents import AFFERENT_TYPES
 
-__all__ = ["plot_response", "plot_sf_vs_theta"]
+__all__ = ["plot_response", "plot_sf_vs_theta", "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces"]
 
 _TYPE_COLOURS = {"SAI": "tab:blue", "RAI": "tab:orange", "RAII": "tab:green"}
 
@@ -96,4 +96,81 @@ def plot_sf_vs_theta(sf: dict, *, title: str = "SF against tuning angle (Fig. 8)
     axes[0].set_ylabel("SF (pulses/s)")
     axes[0].legend(fontsize=8)
     fig.suptitle(title)
+    return fig
+
+
+def plot_raster(ds, *, condition=0, trial=0, max_afferents: int = 2000) -> Figure:
+    """Spike raster sorted by afferent type, then tuning angle theta_T.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A simulation dataset with spike events.
+    condition, trial : int
+        Which condition and trial to draw (positions).
+    max_afferents : int
+        Draw at most this many afferents (evenly subsampled per type).
+    """
+    types = ds.afferent_type.values
+    order = np.lexsort((ds.theta_t.values, [AFFERENT_TYPES.index(t) for t in types]))
+    if order.size > max_afferents:
+        order = order[np.linspace(0, order.size - 1, max_afferents).astype(int)]
+    row = np.full(ds.sizes["afferent"], -1)
+    row[order] = np.arange(order.size)
+    sel = (ds.spike_condition.values == condition) & (ds.spike_trial.values == trial)
+    aff = ds.spike_afferent.values[sel]
+    keep = row[aff] >= 0
+    fig = Figure(figsize=(8.0, 6.0), layout="constrained")
+    ax = fig.subplots()
+    colours = [_TYPE_COLOURS[t] for t in types[aff[keep]]]
+    ax.scatter(ds.spike_time.values[sel][keep], row[aff[keep]], s=1.0, c=colours, marker="|", linewidths=0.5)
+    for kind in AFFERENT_TYPES:
+        rows = row[(types == kind) & (row >= 0)]
+        if rows.size:
+            ax.axhline(rows.max() + 0.5, color="grey", lw=0.5)
+            ax.text(1.01, rows.mean(), kind, transform=ax.get_yaxis_transform(), va="center", color=_TYPE_COLOURS[kind])
+    ax.set_xlim(0, float(ds.duration[condition]))
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("afferent (by type, then theta_T)")
+    ax.set_title(f"raster: {ds.condition.values[condition]}, trial {trial}")
+    return fig
+
+
+def plot_psth(rates) -> Figure:
+    """PSTH per afferent type: ``rates`` is `population.psth` output (condition, type, bin)."""
+    groups = list(rates[rates.dims[1]].values)
+    fig = Figure(figsize=(8.0, 2.2 * len(groups)), layout="constrained")
+    axes = fig.subplots(len(groups), 1, sharex=True, squeeze=False)[:, 0]
+    for ax, group in zip(axes, groups):
+        for c, name in enumerate(rates.condition.values):
+            ax.plot(rates.bin.values, rates.isel(condition=c).sel({rates.dims[1]: group}).values, lw=1.0, label=str(name))
+        ax.set_ylabel(f"{group}\n(pulses/s)")
+    axes[0].legend(fontsize=7)
+    axes[-1].set_xlabel("time (s)")
+    return fig
+
+
+def plot_polar_counts(ds, *, condition=0) -> Figure:
+    """Polar plot of spike count (mean over trials) against theta_T, per type."""
+    counts = ds.spike_count.isel(condition=condition).mean("trial").values
+    fig = Figure(figsize=(4.0 * len(AFFERENT_TYPES), 4.0), layout="constrained")
+    for i, kind in enumerate(AFFERENT_TYPES):
+        ax = fig.add_subplot(1, len(AFFERENT_TYPES), i + 1, projection="polar")
+        sel = ds.afferent_type.values == kind
+        ax.scatter(np.deg2rad(ds.theta_t.values[sel]), counts[sel], s=4, color=_TYPE_COLOURS[kind])
+        ax.set_title(kind)
+    fig.suptitle(f"spike count against theta_T: {ds.condition.values[condition]}")
+    return fig
+
+
+def plot_forces(ds) -> Figure:
+    """The scene forces of every condition."""
+    n = ds.sizes["condition"]
+    fig = Figure(figsize=(8.0, 2.0 * n), layout="constrained")
+    axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
+    for c, ax in enumerate(axes):
+        forces = {name: ds[name].isel(condition=c).values for name in ("fx", "fy", "fz")}
+        _plot_forces(ax, ds.time.values, forces)
+        ax.set_title(str(ds.condition.values[c]), fontsize=9)
+    axes[-1].set_xlabel("time (s)")
     return fig

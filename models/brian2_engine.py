@@ -27,6 +27,7 @@ Design (measured on this machine kind, see README "Engines"):
 
 from __future__ import annotations
 
+import gc
 import hashlib
 import os
 import sys
@@ -89,7 +90,7 @@ def _pad(n: int, quantum: int) -> int:
 
 
 def _key_dir(key: tuple) -> Path:
-    import brian2
+    brian2 = _import_brian2()
 
     text = repr((key, brian2.__version__, _COMPILE_ARGS, _TEMPLATE_VERSION, _EQUATIONS))
     digest = hashlib.sha256(text.encode()).hexdigest()[:16]
@@ -97,10 +98,19 @@ def _key_dir(key: tuple) -> Path:
     return cache_dir() / f"n{n_neurons}_t{n_samples}_s{substeps}_{method}_{digest}"
 
 
+def _import_brian2():
+    """Import Brian2 quietly: no banner or script copies on unrelated exceptions."""
+    import brian2
+
+    brian2.prefs["logging.display_brian_error_message"] = False
+    brian2.prefs["logging.save_script"] = False
+    return brian2
+
+
 @contextmanager
 def _brian2_prefs():
     """Set the preferences the build needs, restoring the user's afterwards."""
-    import brian2
+    brian2 = _import_brian2()
 
     saved = {
         "codegen.cpp.extra_compile_args_gcc": list(brian2.prefs["codegen.cpp.extra_compile_args_gcc"]),
@@ -132,6 +142,10 @@ def _build(key: tuple) -> _Build:
 
         standalone = all_devices["cpp_standalone"]  # one singleton per process
         standalone.reinit()  # forget the previously built project, if any
+        # Brian2 names objects uniquely among those alive; once the previous
+        # build is gone, this build reuses the cached project's exact names
+        # (a stale name would become "..._1" and force a full recompile).
+        gc.collect()
         b2.set_device(standalone, directory=str(directory), build_on_run=False)
         fs = 1.0 / (dt * substeps)
         ta = b2.TimedArray(np.zeros((n_samples, n_neurons)), dt=(1.0 / fs) * b2.second, name="ddmm_current")
@@ -164,7 +178,7 @@ def _build(key: tuple) -> _Build:
 def _activate(key: tuple) -> _Build:
     global _ACTIVE
     if _ACTIVE is None or _ACTIVE.key != key:
-        _ACTIVE = None
+        _ACTIVE = None  # release the previous build before naming the new one
         _ACTIVE = _build(key)
     return _ACTIVE
 

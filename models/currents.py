@@ -155,8 +155,10 @@ def _filter_deviation(f_a, fs, params, state: FilterState):
     """Low-passed deviation from ``state.offset`` and the state after it."""
     sos = lowpass_sos(params.cutoff_hz, params.filter_order, fs)
     dev, zi = signal.sosfilt(sos, f_a - state.offset, axis=0, zi=state.zi)
-    history = np.concatenate([state.y2[None], state.y1[None], dev], axis=0)
-    return dev, FilterState(zi=zi, offset=state.offset, y1=history[-1].copy(), y2=history[-2].copy())
+    n = dev.shape[0]
+    y1 = dev[-1].copy() if n >= 1 else state.y1
+    y2 = dev[-2].copy() if n >= 2 else (state.y1 if n == 1 else state.y2)
+    return dev, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2)
 
 
 def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=None):
@@ -189,11 +191,23 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
 
 
 def _backward_differences(dev, fs, state: FilterState, order: int) -> np.ndarray:
-    """First (order=1) or second (order=2) backward difference, per second^order."""
-    padded = np.concatenate([state.y2[None], state.y1[None], dev], axis=0)
+    """First (order=1) or second (order=2) backward difference, per second^order.
+
+    ``state`` holds the two samples before ``dev``, so chunks join exactly.
+    """
+    prev1 = np.empty_like(dev)  # dev shifted by one sample
+    prev1[:1] = state.y1
+    prev1[1:] = dev[:-1]
     if order == 1:
-        return (padded[2:] - padded[1:-1]) * fs
-    return (padded[2:] - 2.0 * padded[1:-1] + padded[:-2]) * (fs * fs)
+        out = dev - prev1
+        out *= fs
+        return out
+    prev2 = np.empty_like(dev)  # shifted by two
+    prev2[:2] = np.stack([state.y2, state.y1])[: dev.shape[0]]
+    prev2[2:] = dev[:-2]
+    out = dev - 2.0 * prev1 + prev2
+    out *= fs * fs
+    return out
 
 
 def afferent_current(
@@ -202,6 +216,7 @@ def afferent_current(
     afferent_type: str,
     params: CurrentParams = CurrentParams(),
     state: FilterState | None = None,
+    scale=None,
 ):
     """Input current of afferents of one type (eqs 1-3).
 
@@ -217,6 +232,9 @@ def afferent_current(
         Gains and derivative filter.
     state : FilterState, optional
         Filter state carried over from a previous chunk (RAI and RAII only).
+    scale : array_like, shape (n_afferents,), optional
+        Per-afferent multiplier of the drive (gain variability, receptive
+        field weight), applied before the optional compressive transducer.
 
     Returns
     -------
@@ -235,14 +253,17 @@ def afferent_current(
     check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
     fs = check_positive(fs, "fs", "Hz")
     f_a = as_finite_array(f_a, "f_a", ndim=2)
+    gain = params.gain(afferent_type)
+    if scale is not None:
+        gain = gain * np.asarray(scale, dtype=float)
     if afferent_type == "SAI":
-        return _saturate(params.g_sai * np.abs(f_a), params), None
+        return _saturate(gain * np.abs(f_a), params), None
     if state is None:
         state = initial_filter_state(f_a[0], fs, params)
     dev, new_state = _filter_deviation(f_a, fs, params, state)
     order = 1 if afferent_type == "RAI" else 2
     deriv = _backward_differences(dev, fs, state, order)
-    return _saturate(params.gain(afferent_type) * np.abs(deriv), params), new_state
+    return _saturate(gain * np.abs(deriv), params), new_state
 
 
 def _saturate(drive, params: CurrentParams):

@@ -46,48 +46,63 @@ def default_threads() -> int:
 
 
 @nb.njit(cache=True, nogil=True)
-def _grow(buf, n):
-    out = np.empty(max(16, 2 * buf.size), buf.dtype)
+def _euler_block(current, substeps, dt_ms, a, b, c, d, v, u, v_peak, j0, k_start, idx, stp, n):
+    """Advance one block (local arrays a..u, columns j0.. of ``current``) from sample k_start.
+
+    Spikes go to the fixed buffers ``idx``/``stp`` from position ``n``.  The
+    buffers are never reallocated here (that would stop the update loop from
+    vectorising); when one more sample could overflow them, the kernel
+    returns early and the caller grows them and resumes.  Returns the sample
+    to resume at (``n_samples`` when done) and the new fill level.
+    """
+    n_samples = current.shape[0]
+    m = v.size
+    for k in range(k_start, n_samples):
+        if n + m * substeps > idx.size:
+            return k, n
+        row = current[k, j0 : j0 + m]
+        for s in range(substeps):
+            step = k * substeps + s
+            for j in range(m):
+                vj = v[j]
+                uj = u[j]
+                # Same association as Brian2's generated code (see module doc).
+                u[j] = (dt_ms * (a[j] * ((b[j] * vj) - uj))) + uj
+                v[j] = (dt_ms * ((140.0 + ((row[j] + (0.04 * (vj * vj))) + (5.0 * vj))) - uj)) + vj
+            for j in range(m):
+                if v[j] >= v_peak:
+                    v[j] = c[j]
+                    u[j] = u[j] + d[j]
+                    idx[n] = j0 + j
+                    stp[n] = step
+                    n += 1
+    return n_samples, n
+
+
+@nb.njit(cache=True, nogil=True)
+def _double(buf, n):
+    out = np.empty(2 * buf.size, buf.dtype)
     out[:n] = buf[:n]
     return out
 
 
 @nb.njit(cache=True, nogil=True)
-def _euler_block(current, substeps, dt_ms, a, b, c, d, v, u, v_peak, j0, j1, idx, stp, n):
-    """Advance neurons j0..j1 over all samples; append spikes to (idx, stp)."""
-    n_samples = current.shape[0]
-    for k in range(n_samples):
-        for s in range(substeps):
-            step = k * substeps + s
-            for j in range(j0, j1):
-                vj = v[j]
-                uj = u[j]
-                # Same association as Brian2's generated code (see module doc).
-                u[j] = (dt_ms * (a[j] * ((b[j] * vj) - uj))) + uj
-                v[j] = (dt_ms * ((140.0 + ((current[k, j] + (0.04 * (vj * vj))) + (5.0 * vj))) - uj)) + vj
-            for j in range(j0, j1):
-                if v[j] >= v_peak:
-                    v[j] = c[j]
-                    u[j] = u[j] + d[j]
-                    if n == idx.size:
-                        idx = _grow(idx, n)
-                        stp = _grow(stp, n)
-                    idx[n] = j
-                    stp[n] = step
-                    n += 1
-    return idx, stp, n
-
-
-@nb.njit(cache=True, nogil=True)
-def _integrate_range(current, substeps, dt_ms, a, b, c, d, v, u, v_peak, block):
-    """Integrate every neuron of the given column range; return spike arrays."""
-    n_neurons = current.shape[1]
-    idx = np.empty(1024, np.int64)
-    stp = np.empty(1024, np.int64)
-    n = 0
-    for j0 in range(0, n_neurons, block):
-        j1 = min(n_neurons, j0 + block)
-        idx, stp, n = _euler_block(current, substeps, dt_ms, a, b, c, d, v, u, v_peak, j0, j1, idx, stp, n)
+def _integrate_range(current, substeps, dt_ms, a, b, c, d, v, u, v_peak, block, lo, hi):
+    """Integrate neurons lo..hi (columns of the C-contiguous ``current``); return spikes."""
+    capacity = max(4096, 4 * block * substeps)
+    idx, stp, n = np.empty(capacity, np.int64), np.empty(capacity, np.int64), 0
+    for j0 in range(lo, hi, block):
+        j1 = min(hi, j0 + block)
+        # Fresh local copies: LLVM can prove they do not alias and vectorises.
+        ab, bb, cb, db = a[j0:j1].copy(), b[j0:j1].copy(), c[j0:j1].copy(), d[j0:j1].copy()
+        vb, ub = v[j0:j1].copy(), u[j0:j1].copy()
+        k = 0
+        while k < current.shape[0]:
+            k, n = _euler_block(current, substeps, dt_ms, ab, bb, cb, db, vb, ub, v_peak, j0, k, idx, stp, n)
+            if k < current.shape[0]:  # buffers nearly full: double them and resume
+                idx, stp = _double(idx, n), _double(stp, n)
+        v[j0:j1] = vb
+        u[j0:j1] = ub
     return idx[:n].copy(), stp[:n].copy()
 
 
@@ -139,12 +154,10 @@ def run_direct(current, substeps, dt, params, v, u, method="euler", v_peak=30.0,
     bounds[0] = 0
     args = [params[p] for p in ("a", "b", "c", "d")]
 
+    # The whole C-contiguous array goes to every thread (a column slice would
+    # be strided and defeat vectorisation); each thread owns a column range.
     def work(lo, hi):
-        sl = slice(lo, hi)
-        idx, stp = _integrate_range(
-            current[:, sl], substeps, dt_ms, *(x[sl] for x in args), v[sl], u[sl], v_peak, _BLOCK
-        )
-        return idx + lo, stp
+        return _integrate_range(current, substeps, dt_ms, *args, v, u, v_peak, _BLOCK, int(lo), int(hi))
 
     ranges = list(zip(bounds[:-1], bounds[1:]))
     if len(ranges) == 1:

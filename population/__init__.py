@@ -1,1 +1,15 @@
-"""Populations of afferents: scenes, specs, sampling, simulation, datasets, decoding."""
+"""Populations of afferents: specs, sampling, scenes, simulation, datasets."""
+
+from .dataset import binned_counts, binned_rates, describe_dataset, load_dataset, psth, save_dataset
+from .plan import make_plan
+from .sampling import Population, make_population, sample_population
+from .scenes import Contact, Scene, Stage, birznieks, from_csv, press_push_lift, rotating_shear
+from .simulate import plan_run, simulate
+from .spec import PopulationSpec, load_spec, spec_from_dict
+
+__all__ = [
+    "binned_counts", "binned_rates", "describe_dataset", "load_dataset", "psth", "save_dataset",
+    "make_plan", "Population", "make_population", "sample_population",
+    "Contact", "Scene", "Stage", "birznieks", "from_csv", "press_push_lift", "rotating_shear",
+    "plan_run", "simulate", "PopulationSpec", "load_spec", "spec_from_dict",
+]

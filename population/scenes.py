@@ -21,6 +21,7 @@ __all__ = [
     "birznieks",
     "press_push_lift",
     "rotating_shear",
+    "from_csv",
 ]
 
 #: Default force sample rate in Hz: 50x the 20 Hz derivative cut-off.
@@ -231,3 +232,107 @@ def rotating_shear(*, normal_n: float = 4.0, shear_n: float = 1.456, period_s: f
               Stage("unloading", ramp_s + rotate_s, knots[-1]))
     return Scene(shear * np.cos(angle), shear * np.sin(angle), normal_n * envelope, fs,
                  "rotating_shear", stages, contact, None)
+
+
+_CSV_FIELDS = ("time", "fx", "fy", "fz")
+
+
+def _read_csv_columns(path, columns: dict) -> dict:
+    """Read the mapped columns of a CSV file as float arrays, with clear errors."""
+    import csv
+
+    try:
+        with open(path, newline="") as fh:
+            rows = [row for row in csv.reader(fh) if row and any(cell.strip() for cell in row)]
+    except OSError as exc:
+        raise ValueError(f"scene file {str(path)!r} cannot be read: {exc.strerror}") from None
+    if not rows:
+        raise ValueError(f"scene file {str(path)!r} is empty")
+    header = [h.strip() for h in rows[0]]
+    index = {}
+    for ours, theirs in columns.items():
+        if theirs not in header:
+            raise ValueError(f"scene file {str(path)!r} has no column {theirs!r} (for {ours}); header: {','.join(header)}")
+        index[ours] = header.index(theirs)
+    if len(rows) < 2:
+        raise ValueError(f"scene file {str(path)!r} has a header but no data rows")
+    out = {k: np.empty(len(rows) - 1) for k in columns}
+    for r, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise ValueError(
+                f"scene file {str(path)!r}: columns of unequal length, line {r} has {len(row)} values "
+                f"but the header has {len(header)}"
+            )
+        for ours, i in index.items():
+            try:
+                out[ours][r - 2] = float(row[i])
+            except ValueError:
+                raise ValueError(f"scene file {str(path)!r}: column {columns[ours]!r}, line {r}: "
+                                 f"{row[i]!r} is not a number") from None
+    return out
+
+
+def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, time_scale: float = 1.0,
+             force_scale: float = 1.0, name: str | None = None, contact: Contact | None = None,
+             negative_fz: str = "error") -> Scene:
+    """A scene from recorded force data (e.g. a 100 Hz force-plate export).
+
+    The file needs a header; by default its columns are ``time,fx,fy,fz`` in
+    seconds and newtons.  Values are validated (numeric, finite, time strictly
+    increasing, F_Z >= 0) and linearly resampled onto a uniform grid at
+    ``fs``, starting at t = 0 for the first row.
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file.
+    columns : dict, optional
+        Our names (``time``, ``fx``, ``fy``, ``fz``) to the file's column
+        names, e.g. ``{"time": "t_s", "fz": "Fz"}``; unnamed ones keep ours.
+    fs : float
+        Output sample rate in Hz.
+    time_scale, force_scale : float
+        Multipliers to seconds and newtons (e.g. 1e-3 for milliseconds).
+    name : str, optional
+        Condition name (default: the file stem).
+    contact : Contact, optional
+        Contact geometry.
+    negative_fz : {"error", "clip"}
+        A negative normal force is an error, or (for sensor noise around
+        zero) clipped to 0.
+
+    Raises
+    ------
+    ValueError
+        Naming the file, column and line of the first problem.
+    """
+    from pathlib import Path
+
+    mapping = {k: k for k in _CSV_FIELDS}
+    for key in columns or {}:
+        if key not in mapping:
+            raise ValueError(f"columns: unknown key {key!r}; allowed: {', '.join(_CSV_FIELDS)}")
+    mapping.update(columns or {})
+    if negative_fz not in ("error", "clip"):
+        raise ValueError(f"negative_fz={negative_fz!r} is not allowed; allowed: error, clip")
+    check_positive(fs, "fs", "Hz")
+    data = _read_csv_columns(path, mapping)
+    for key, arr in data.items():
+        if not np.all(np.isfinite(arr)):
+            line = int(np.flatnonzero(~np.isfinite(arr))[0]) + 2
+            raise ValueError(f"scene file {str(path)!r}: column {mapping[key]!r} has a non-finite value on line {line}")
+    t = data["time"] * check_positive(time_scale, "time_scale")
+    if np.any(np.diff(t) <= 0):
+        line = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 3
+        raise ValueError(f"scene file {str(path)!r}: time must be strictly increasing (line {line})")
+    scale = check_positive(force_scale, "force_scale")
+    fz = data["fz"] * scale
+    if np.any(fz < 0):
+        if negative_fz == "error":
+            line = int(np.flatnonzero(fz < 0)[0]) + 2
+            raise ValueError(f"scene file {str(path)!r}: negative normal force {fz[line - 2]!r} N on line {line}"
+                             " (use negative_fz='clip' for sensor noise around zero)")
+        fz = np.maximum(fz, 0.0)
+    grid = np.arange(int(np.floor((t[-1] - t[0]) * fs + 1e-9)) + 1) / fs
+    resampled = [np.interp(grid, t - t[0], arr) for arr in (data["fx"] * scale, data["fy"] * scale, fz)]
+    return Scene(*resampled, fs=fs, name=name or Path(path).stem, contact=contact)

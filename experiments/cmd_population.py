@@ -1,0 +1,150 @@
+"""``ddmm simulate | plan | info | plot | demo``: population runs from the command line."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from population import (Contact, birznieks, describe_dataset, from_csv, load_dataset, load_spec,
+                        plan_run, press_push_lift, psth, rotating_shear, sample_population,
+                        save_dataset, simulate)
+
+from .io import ensure_out_dir, save_figure
+
+__all__ = ["register", "scenes_from_args", "write_plots"]
+
+SCENES = ("birznieks", "press-push-lift", "rotating-shear")
+
+
+def _add_run_options(p, *, out_required: bool) -> None:
+    p.add_argument("--population", default="fingertip", help="fingertip, hand or a spec .toml file")
+    p.add_argument("--scene", default="birznieks", help=f"{', '.join(SCENES)} or a force .csv file")
+    p.add_argument("--theta-r", default=None, metavar="DEG[,DEG...]",
+                   help="shear direction(s) in degrees, one condition each ('none': normal only); default 90")
+    p.add_argument("--contact", default=None, metavar="X,Y,R", help="contact centre and radius in mm")
+    p.add_argument("--engine", choices=("brian2", "direct"), default="brian2")
+    p.add_argument("--dt", type=float, default=0.1, metavar="MS", help="integration step in ms (default 0.1)")
+    p.add_argument("--trials", type=int, default=1)
+    p.add_argument("--seed", type=int, default=0, help="seed of the population and the noise (default 0)")
+    p.add_argument("--no-shear", choices=("pass", "block"), default="pass")
+    p.add_argument("--types", default=None, metavar="T[,T...]", help="afferent types to simulate")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--out", required=out_required, metavar="FILE.nc")
+
+
+def register(sub) -> None:
+    """Add the population subcommands."""
+    p = sub.add_parser("simulate", help="simulate a population on a scene into a netCDF dataset")
+    _add_run_options(p, out_required=True)
+    p.set_defaults(func=run_simulate)
+    p = sub.add_parser("plan", help="print what a simulate run would compute and skip")
+    _add_run_options(p, out_required=False)
+    p.set_defaults(func=run_plan)
+    p = sub.add_parser("info", help="summarise a dataset file")
+    p.add_argument("file")
+    p.set_defaults(func=run_info)
+    p = sub.add_parser("plot", help="raster, PSTH, polar and force figures of a dataset")
+    p.add_argument("file")
+    p.add_argument("--out", required=True, metavar="DIR")
+    p.set_defaults(func=run_plot)
+
+
+def _directions(text, default="90"):
+    out = []
+    for part in (text or default).split(","):
+        part = part.strip()
+        if part.lower() == "none":
+            out.append(None)
+            continue
+        try:
+            out.append(float(part))
+        except ValueError:
+            raise ValueError(f"--theta-r: {part!r} is not a number of degrees or 'none'") from None
+    return out
+
+
+def _contact(text):
+    if text is None:
+        return None
+    try:
+        x, y, r = (float(v) for v in text.split(","))
+    except ValueError:
+        raise ValueError(f"--contact must be X,Y,R in mm, got {text!r}") from None
+    return Contact(x, y, r)
+
+
+def scenes_from_args(args) -> list:
+    """The scenes named by ``--scene``, ``--theta-r`` and ``--contact``."""
+    contact = _contact(args.contact)
+    if args.scene == "birznieks":
+        return [birznieks(d, contact=contact) for d in _directions(args.theta_r)]
+    if args.scene == "press-push-lift":
+        dirs = _directions(args.theta_r)
+        if None in dirs:
+            raise ValueError("--theta-r none is only meaningful for the birznieks scene")
+        return [press_push_lift(d, contact=contact) for d in dirs]
+    if args.scene == "rotating-shear":
+        start = _directions(args.theta_r, default="0")
+        return [rotating_shear(start_deg=start[0] or 0.0, contact=contact)]
+    if args.scene.endswith(".csv"):
+        return [from_csv(args.scene, contact=contact)]
+    raise ValueError(f"--scene {args.scene!r} is unknown; allowed: {', '.join(SCENES)} or a .csv file")
+
+
+def _types(text):
+    return None if text is None else tuple(t.strip() for t in text.split(","))
+
+
+def _population(args):
+    return sample_population(load_spec(args.population), rng=args.seed)
+
+
+def _check_out_file(path) -> Path:
+    path = Path(path)
+    if path.suffix != ".nc":
+        raise ValueError(f"--out {str(path)!r} must end in .nc")
+    if not path.parent.is_dir():
+        raise ValueError(f"--out {str(path)!r}: directory {str(path.parent)!r} does not exist")
+    return path
+
+
+def run_simulate(args) -> int:
+    out = _check_out_file(args.out)
+    pop, scenes = _population(args), scenes_from_args(args)
+    start = time.perf_counter()
+    ds = simulate(pop, scenes, engine=args.engine, dt=args.dt * 1e-3, trials=args.trials, seed=args.seed,
+                  no_shear=args.no_shear, types=_types(args.types), quiet=args.quiet)
+    save_dataset(ds, out)
+    if not args.quiet:
+        print(f"wrote {out} ({ds.sizes['afferent']} afferents, {ds.sizes['spike']} spikes, "
+              f"{time.perf_counter() - start:.2f} s)")
+    return 0
+
+
+def run_plan(args) -> int:
+    pop, scenes = _population(args), scenes_from_args(args)
+    the_plan = plan_run(pop, scenes, trials=args.trials, no_shear=args.no_shear, types=_types(args.types))
+    print(the_plan.describe(pop, scenes))
+    return 0
+
+
+def run_info(args) -> int:
+    print(describe_dataset(load_dataset(args.file)))
+    return 0
+
+
+def write_plots(ds, out_dir) -> list:
+    """Write the standard figures of a dataset; returns the paths."""
+    from .plotting import plot_forces, plot_polar_counts, plot_psth, plot_raster  # matplotlib is slow to import
+
+    out_dir = ensure_out_dir(out_dir)
+    bin_s = max(0.005, float(ds.duration.max()) / 100.0)
+    figures = {"raster.png": plot_raster(ds), "psth.png": plot_psth(psth(ds, bin_s)),
+               "polar.png": plot_polar_counts(ds), "forces.png": plot_forces(ds)}
+    return [str(save_figure(fig, out_dir / name)) for name, fig in figures.items()]
+
+
+def run_plot(args) -> int:
+    for path in write_plots(load_dataset(args.file), args.out):
+        print(f"wrote {path}")
+    return 0

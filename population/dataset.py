@@ -1,0 +1,227 @@
+"""The simulation Dataset: schema, netCDF round trip, rates and PSTHs.
+
+Schema (names are fixed):
+
+* dims ``condition`` (one per scene), ``trial``, ``afferent``, ``spike``
+  (events) and ``time`` (force samples);
+* coords on ``afferent``: ``afferent`` (the stable afferent id),
+  ``afferent_type``, ``theta_t`` (deg), ``nap``, ``k``, ``gain``, ``x_mm``,
+  ``y_mm``, ``noise_sigma``; on ``condition``: ``condition`` (scene name),
+  ``duration`` (s), ``theta_r`` (deg) with ``has_theta_r`` (1 when the scene
+  has one nominal shear direction); ``time`` (s);
+* data vars ``spike_count(condition, trial, afferent)``; the events
+  ``spike_time`` (s), ``spike_afferent`` (position on ``afferent``),
+  ``spike_trial`` and ``spike_condition`` (positions), sorted by condition,
+  trial, time and afferent; the forces ``fx``, ``fy``, ``fz``
+  ``(condition, time)`` in N, zero after a shorter scene's end;
+* attrs: engine, dt, method, seed, no-shear reading, package version and
+  every model constant.  Every variable carries ``attrs["units"]``.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from importlib import metadata
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from models.attenuation import F_TH
+from models.metrics import CONTACT_THRESHOLD
+from models.neuron import NEURON_PARAMS, V_PEAK
+
+from .spatial import RF_SIGMA_MM, RF_SUPPORT
+
+__all__ = ["build_dataset", "save_dataset", "load_dataset", "binned_counts", "binned_rates", "psth",
+           "describe_dataset"]
+
+
+def _version() -> str:
+    try:
+        return metadata.version("ddmm")
+    except metadata.PackageNotFoundError:  # running from a source tree
+        return "0+unknown"
+
+
+def model_attrs(population, config) -> dict:
+    """Every constant that shapes the spikes, as flat netCDF-safe attrs."""
+    cp = population.current
+    attrs = {
+        "ddmm_version": _version(), "engine": config.engine, "dt": config.dt, "method": config.method,
+        "seed": config.seed, "no_shear": config.no_shear, "population": population.name,
+        "frame": "+X radial, +Y distal; theta 0 radial, 90 distal, 180 ulnar, 270 proximal",
+        "f_th": F_TH, "contact_threshold": CONTACT_THRESHOLD, "v_peak": V_PEAK,
+        "current_g_sai": cp.g_sai, "current_g_rai": cp.g_rai, "current_g_raii": cp.g_raii,
+        "current_cutoff_hz": cp.cutoff_hz, "current_filter_order": cp.filter_order,
+        "current_i_sat": "none" if cp.i_sat is None else cp.i_sat,
+        "noise_model": "white Gaussian current, sigma/sqrt(h) per sample of h ms",
+        "rf_support": RF_SUPPORT,
+    }
+    for kind, params in NEURON_PARAMS.items():
+        for name in ("a", "b", "c", "d"):
+            attrs[f"neuron_{kind}_{name}"] = getattr(params, name)
+    for kind, sigma in RF_SIGMA_MM.items():
+        attrs[f"rf_sigma_{kind}_mm"] = sigma
+    return attrs
+
+
+def _afferent_coords(population, index) -> dict:
+    pop = population
+    coords = {
+        "afferent": ("afferent", pop.afferent_id[index].astype(np.int64), {"units": "1", "long_name": "afferent id"}),
+        "afferent_type": ("afferent", pop.afferent_type[index].astype(object), {"units": "1"}),
+        "theta_t": ("afferent", pop.theta_t[index].astype(float), {"units": "deg"}),
+        "nap": ("afferent", pop.nap[index].astype(object), {"units": "1"}),
+        "k": ("afferent", pop.k[index].astype(float), {"units": "1", "note": "0 for untuned afferents"}),
+        "gain": ("afferent", pop.gain[index].astype(float), {"units": "1"}),
+        "x_mm": ("afferent", pop.x_mm[index].astype(float), {"units": "mm"}),
+        "y_mm": ("afferent", pop.y_mm[index].astype(float), {"units": "mm"}),
+        "noise_sigma": ("afferent", pop.noise_sigma[index].astype(float), {"units": "mV/sqrt(ms)"}),
+    }
+    return {k: xr.Variable(*v) for k, v in coords.items()}
+
+
+def _condition_coords(scenes) -> dict:
+    theta = [0.0 if s.theta_r is None else float(s.theta_r) % 360.0 for s in scenes]
+    return {
+        "condition": xr.Variable("condition", np.array([s.name for s in scenes], dtype=object), {"units": "1"}),
+        "duration": xr.Variable("condition", np.array([s.duration for s in scenes]), {"units": "s"}),
+        "theta_r": xr.Variable("condition", np.array(theta), {"units": "deg"}),
+        "has_theta_r": xr.Variable("condition", np.array([s.theta_r is not None for s in scenes], np.int8),
+                                   {"units": "1"}),
+    }
+
+
+def _events(plan, spikes, dt):
+    """Concatenate per-condition spikes, keep requested afferents, sort."""
+    remap = np.full(plan.selected.size, -1, np.int64)
+    remap[plan.keep] = np.arange(plan.keep.size)
+    cols = [[], [], [], []]
+    for c, parts in enumerate(spikes):
+        for trial, pos, step in parts:
+            aff = remap[pos]
+            ok = aff >= 0
+            for col, arr in zip(cols, (np.full(ok.sum(), c), trial[ok], step[ok], aff[ok])):
+                col.append(np.asarray(arr, np.int64))
+    cond, trial, step, aff = (np.concatenate(c) if c else np.empty(0, np.int64) for c in cols)
+    order = np.lexsort((aff, step, trial, cond))
+    return cond[order], trial[order], step[order] * dt, aff[order]
+
+
+def build_dataset(population, scenes, plan, spikes, config) -> xr.Dataset:
+    """Assemble the Dataset of a run (schema in the module docstring)."""
+    cond, trial, time, aff = _events(plan, spikes, config.dt)
+    n_c, n_t, n_a = len(scenes), plan.trials, plan.keep.size
+    counts = np.zeros((n_c, n_t, n_a), np.int32)
+    np.add.at(counts, (cond, trial, aff), 1)
+    data = {"spike_count": xr.Variable(("condition", "trial", "afferent"), counts, {"units": "1"})}
+    if "spikes" in plan.record:
+        data["spike_time"] = xr.Variable("spike", time, {"units": "s"})
+        for name, arr in (("spike_afferent", aff), ("spike_trial", trial), ("spike_condition", cond)):
+            data[name] = xr.Variable("spike", arr.astype(np.int32), {"units": "1", "note": "position index"})
+    coords = {**_afferent_coords(population, plan.selected[plan.keep]), **_condition_coords(scenes),
+              "trial": xr.Variable("trial", np.arange(n_t, dtype=np.int64), {"units": "1"})}
+    if "forces" in plan.record:
+        n_time = max(s.n_samples for s in scenes)
+        coords["time"] = xr.Variable("time", np.arange(n_time) / scenes[0].fs, {"units": "s"})
+        for name in ("fx", "fy", "fz"):
+            arr = np.zeros((n_c, n_time))
+            for c, s in enumerate(scenes):
+                arr[c, : s.n_samples] = getattr(s, name)
+            data[name] = xr.Variable(("condition", "time"), arr, {"units": "N"})
+    attrs = dict(model_attrs(population, config), fs=float(scenes[0].fs), trials=n_t)
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def save_dataset(ds: xr.Dataset, path) -> Path:
+    """Write ``ds`` to netCDF (HDF5) atomically: a failed write leaves no file.
+
+    Raises
+    ------
+    ValueError
+        If the directory does not exist or cannot be written.
+    """
+    path = Path(path)
+    directory = path.parent if str(path.parent) else Path(".")
+    if not directory.is_dir() or not os.access(directory, os.W_OK):
+        raise ValueError(f"cannot write {str(path)!r}: {str(directory)!r} is not a writable directory")
+    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".part")
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, engine="h5netcdf")
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def load_dataset(path) -> xr.Dataset:
+    """Read a dataset written by `save_dataset` fully into memory."""
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"dataset file {str(path)!r} does not exist")
+    return xr.load_dataset(path, engine="h5netcdf")
+
+
+def binned_counts(ds: xr.Dataset, bin_s: float, *, t_max: float | None = None) -> xr.DataArray:
+    """Spike counts per (condition, trial, afferent, bin) from the events."""
+    if "spike_time" not in ds:
+        raise ValueError("the dataset has no spike events; simulate with record including 'spikes'")
+    if not bin_s > 0:
+        raise ValueError(f"bin_s must be > 0, got {bin_s!r}")
+    t_max = float(ds.duration.max()) if t_max is None else t_max
+    edges = np.arange(0.0, t_max + bin_s / 2, bin_s)
+    n_bins = max(1, edges.size - 1)
+    b = np.minimum((ds.spike_time.values // bin_s).astype(np.int64), n_bins - 1)
+    keep = ds.spike_time.values < edges[-1]
+    shape = (ds.sizes["condition"], ds.sizes["trial"], ds.sizes["afferent"], n_bins)
+    out = np.zeros(shape, np.int32)
+    np.add.at(out, (ds.spike_condition.values[keep], ds.spike_trial.values[keep],
+                    ds.spike_afferent.values[keep], b[keep]), 1)
+    centers = (np.arange(n_bins) + 0.5) * bin_s
+    return xr.DataArray(out, dims=("condition", "trial", "afferent", "bin"),
+                        coords={**{k: ds[k] for k in ("condition", "trial")}, **ds.afferent.coords,
+                                "bin": ("bin", centers, {"units": "s"})},
+                        attrs={"units": "1", "bin_s": bin_s})
+
+
+def binned_rates(ds: xr.Dataset, bin_s: float, **kwargs) -> xr.DataArray:
+    """Firing rate per (condition, trial, afferent, bin) in pulses/s.
+
+    Examples
+    --------
+    >>> from population import make_population, birznieks, simulate
+    >>> ds = simulate(make_population(["SAI"]), birznieks(90.0), engine="direct", quiet=True)
+    >>> binned_rates(ds, 0.1).sizes["bin"]
+    5
+    """
+    counts = binned_counts(ds, bin_s, **kwargs)
+    return (counts / bin_s).assign_attrs(units="1/s", bin_s=bin_s)
+
+
+def psth(ds: xr.Dataset, bin_s: float = 0.01, *, by: str = "afferent_type") -> xr.DataArray:
+    """Peri-stimulus time histogram: mean rate (pulses/s) per condition, group and bin.
+
+    Averages over trials and over the afferents of each value of ``by``
+    (a coordinate on ``afferent``, e.g. ``"afferent_type"`` or ``"nap"``).
+    """
+    rates = binned_rates(ds, bin_s).mean("trial")
+    return rates.groupby(by).mean("afferent").assign_attrs(units="1/s", bin_s=bin_s)
+
+
+def describe_dataset(ds: xr.Dataset) -> str:
+    """A short text summary (``ddmm info``)."""
+    lines = [f"population {ds.attrs.get('population')!r}: {ds.sizes['afferent']} afferents, "
+             f"{ds.sizes['condition']} condition(s), {ds.sizes['trial']} trial(s)",
+             f"engine {ds.attrs['engine']}, method {ds.attrs['method']}, dt {ds.attrs['dt'] * 1e3:g} ms, "
+             f"seed {ds.attrs['seed']}, no_shear {ds.attrs['no_shear']}, ddmm {ds.attrs['ddmm_version']}"]
+    for c, name in enumerate(ds.condition.values):
+        counts = ds.spike_count.isel(condition=c)
+        dur = float(ds.duration[c])
+        parts = [f"{t}: {float(counts.where(ds.afferent_type == t, drop=True).mean()) / dur:.1f}"
+                 for t in np.unique(ds.afferent_type.values)]
+        lines.append(f"- {name} ({dur:g} s): {int(counts.sum())} spikes; mean rate (pulses/s) " + ", ".join(parts))
+    return "\n".join(lines)

@@ -1,0 +1,306 @@
+"""Simulating a population on a set of scenes, into an xarray Dataset.
+
+The work is cut into *chunks*: a block of afferents (``chunk_size``) over a
+block of samples (``time_chunk``).  Filter state, neuron state and noise
+streams carry from one time block to the next, so peak memory is bounded by
+the chunk, not by the scene's length, and no engine call comes near Brian2's
+32-bit index limit.  Each afferent block is a self-contained `ChunkJob`
+whose result depends only on its own afferents: chunk size never changes a
+spike.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+
+import numpy as np
+
+from models._validation import check_choice, check_positive
+from models.attenuation import NO_SHEAR_READINGS, UNTUNED, attenuated_force, attenuation_factor
+from models.currents import afferent_current
+from models.engines import ENGINES, METHODS, integrate, substeps_for
+
+from .noise import draw_noise, noise_streams, root_seed
+from .plan import RECORD_CHOICES, make_plan
+from .sampling import Population
+from .scenes import Scene
+
+__all__ = ["SimConfig", "ChunkJob", "run_chunk", "simulate", "plan_run"]
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """Settings shared by every chunk of a run.
+
+    Attributes
+    ----------
+    engine : {"brian2", "direct"}
+    dt : float
+        Integration step in seconds.
+    method : str
+        Integration scheme.
+    no_shear : {"pass", "block"}
+        Reading of eq. 17.
+    seed : int
+        Root seed of the noise streams.
+    time_chunk : int
+        Samples per time block.
+    """
+
+    engine: str = "brian2"
+    dt: float = 1e-4
+    method: str = "euler"
+    no_shear: str = "pass"
+    seed: int = 0
+    time_chunk: int = 2000
+
+
+@dataclass(frozen=True, eq=False)
+class ChunkJob:
+    """One block of afferents on one condition.
+
+    Attributes
+    ----------
+    scene : Scene
+    population : Population
+        The block's afferents (ids preserved for the noise streams).
+    condition : int
+        Condition index (part of the noise-stream key).
+    trials : tuple of int
+        Trials to run; deterministic blocks run trial 0 only.
+    noisy : bool
+        Whether to add current noise.
+    af_stage : bool
+        Compute AF (else tuned afferents use ``af_constant``).
+    af_constant : float
+        AF when the stage is skipped.
+    weights : ndarray or None
+        Receptive-field weights of the block's afferents.
+    """
+
+    scene: Scene
+    population: Population
+    condition: int
+    trials: tuple
+    noisy: bool
+    af_stage: bool
+    af_constant: float
+    weights: np.ndarray | None
+
+
+def _runs(values) -> list:
+    """(value, slice) for each run of equal values (blocks are sorted by type and NAP)."""
+    values = np.asarray(values)
+    edges = np.flatnonzero(values[1:] != values[:-1]) + 1
+    starts = np.concatenate([[0], edges])
+    ends = np.concatenate([edges, [values.size]])
+    return [(values[a], slice(int(a), int(b))) for a, b in zip(starts, ends)] if values.size else []
+
+
+def _attenuated(job: ChunkJob, sl: slice, no_shear: str) -> np.ndarray:
+    """F_A for the block over samples ``sl`` (newtons)."""
+    pop, scene = job.population, job.scene
+    fz = scene.fz[sl]
+    f_a = np.empty((fz.size, len(pop)))
+    for profile, cols in _runs(pop.nap):
+        if profile == UNTUNED:
+            f_a[:, cols] = fz[:, None]
+        elif not job.af_stage:
+            f_a[:, cols] = job.af_constant * fz[:, None]
+        else:
+            af = attenuation_factor(scene.fx[sl], scene.fy[sl], pop.theta_t[cols], profile, pop.k[cols],
+                                    no_shear=no_shear)
+            f_a[:, cols] = attenuated_force(fz, af)
+    return f_a
+
+
+def _currents(job: ChunkJob, f_a, states: dict, scale) -> np.ndarray:
+    pop = job.population
+    current = np.empty_like(f_a)
+    for i, (kind, cols) in enumerate(_runs(pop.afferent_type)):
+        current[:, cols], states[i] = afferent_current(
+            f_a[:, cols], job.scene.fs, kind, pop.current, states.get(i), scale=scale[cols])
+    return current
+
+
+def _run_trial(job: ChunkJob, trial: int, config: SimConfig, progress=None):
+    pop, scene = job.population, job.scene
+    scale = pop.gain if job.weights is None else pop.gain * job.weights
+    streams = noise_streams(config.seed, job.condition, trial, pop.afferent_id) if job.noisy else None
+    substeps = substeps_for(scene.fs, config.dt)
+    filters, neuron, afferents, steps = {}, None, [], []
+    for start in range(0, scene.n_samples, config.time_chunk):
+        sl = slice(start, min(scene.n_samples, start + config.time_chunk))
+        current = _currents(job, _attenuated(job, sl, config.no_shear), filters, scale)
+        if streams is not None:
+            current += draw_noise(streams, pop.noise_sigma, current.shape[0], scene.fs)
+        res = integrate(current, fs=scene.fs, dt=config.dt, afferent_type=pop.afferent_type,
+                        engine=config.engine, method=config.method, state=neuron)
+        neuron = res.state
+        afferents.append(res.afferent)
+        steps.append(res.step + start * substeps)
+        if progress is not None:
+            progress(current.size)
+    return np.concatenate(afferents), np.concatenate(steps)
+
+
+def run_chunk(job: ChunkJob, config: SimConfig, progress=None):
+    """Simulate one block; returns (trial, afferent index within the block, step) arrays."""
+    trials, afferents, steps = [], [], []
+    for trial in job.trials:
+        aff, stp = _run_trial(job, trial, config, progress)
+        trials.append(np.full(aff.size, trial, np.int64))
+        afferents.append(aff)
+        steps.append(stp)
+    return np.concatenate(trials), np.concatenate(afferents), np.concatenate(steps)
+
+
+def _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_size, time_chunk):
+    if not isinstance(population, Population):
+        raise TypeError(f"population must be a Population (see sample_population), got {type(population).__name__}")
+    scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
+    if not scenes or not all(isinstance(s, Scene) for s in scenes):
+        raise TypeError("scenes must be a Scene or a non-empty sequence of Scenes")
+    if len({s.fs for s in scenes}) != 1:
+        raise ValueError(f"all scenes must share one sample rate, got {sorted({s.fs for s in scenes})} Hz")
+    names = [s.name for s in scenes]
+    if len(set(names)) != len(names):
+        raise ValueError(f"scene names must be unique (they label conditions), got {names}")
+    check_choice(engine, "engine", ENGINES)
+    check_choice(method, "method", METHODS)
+    check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
+    substeps_for(scenes[0].fs, check_positive(dt, "dt", "s"))
+    for name, value in (("trials", trials), ("chunk_size", chunk_size), ("time_chunk", time_chunk)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+            raise ValueError(f"{name} must be a whole number >= 1, got {value!r}")
+    return scenes
+
+
+def plan_run(population, scenes, *, trials=1, record=RECORD_CHOICES, no_shear="pass", types=None,
+             chunk_size=4096, time_chunk=2000, plan=True):
+    """The `Plan` that `simulate` would follow (print it with ``plan.describe``)."""
+    scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
+    return make_plan(population, scenes, types=types, trials=trials, record=record, no_shear=no_shear,
+                     chunk_size=chunk_size, time_chunk=time_chunk, enabled=plan)
+
+
+def _grouped(population, sel, positions):
+    """Positions ordered by (type, NAP), so each group is a contiguous column slice."""
+    idx = sel[positions]
+    order = np.lexsort((population.nap[idx].astype(str), population.afferent_type[idx].astype(str)))
+    return positions[order]
+
+
+def _equal_blocks(positions, chunk_size: int) -> list:
+    """At most ``chunk_size`` per block, sizes within one of each other.
+
+    Equal blocks share one padded engine shape, so Brian2 builds once per run.
+    """
+    if positions.size == 0:
+        return []
+    n_blocks = -(-positions.size // chunk_size)
+    return np.array_split(positions, n_blocks)
+
+
+def _jobs(population, scenes, the_plan):
+    """Yield (condition index, ChunkJob, selected positions of the block, deterministic?)."""
+    sel = the_plan.selected
+    for c, (scene, cond) in enumerate(zip(scenes, the_plan.conditions)):
+        for positions, deterministic in ((cond.units, True), (cond.noisy, False)):
+            positions = _grouped(population, sel, positions)
+            for block in _equal_blocks(positions, the_plan.chunk_size):
+                weights = None if cond.weights is None else cond.weights[block]
+                trials = (0,) if deterministic else tuple(range(the_plan.trials))
+                job = ChunkJob(scene, population.select(sel[block]), c, trials, not deterministic,
+                               cond.af_stage, cond.af_constant, weights)
+                yield c, job, block, deterministic
+
+
+def _unit_members(cond):
+    """Selected positions grouped by deterministic unit: (order, starts)."""
+    det = np.flatnonzero(cond.member_unit >= 0)
+    order = det[np.argsort(cond.member_unit[det], kind="stable")]
+    counts = np.bincount(cond.member_unit[det], minlength=cond.units.size)
+    return order, np.concatenate([[0], np.cumsum(counts)])
+
+
+def _expand(cond, members, the_plan, block, deterministic, result):
+    """Map a block's spikes to (trial, selected position, step), replicating units."""
+    trial, local, step = result
+    if not deterministic:
+        return trial, block[local], step
+    order, starts = members
+    unit = cond.member_unit[block][local]  # the unit each spike belongs to
+    count = starts[unit + 1] - starts[unit]
+    source = np.repeat(np.arange(step.size), count)
+    offset = np.arange(source.size) - np.repeat(np.cumsum(count) - count, count)
+    pos = order[starts[unit][source] + offset]
+    n_trials = the_plan.trials
+    return (np.repeat(np.arange(n_trials, dtype=np.int64), pos.size), np.tile(pos, n_trials),
+            np.tile(step[source], n_trials))
+
+
+def simulate(population, scenes, *, engine="brian2", dt=1e-4, method="euler", trials=1, seed=None,
+             record=RECORD_CHOICES, no_shear="pass", types=None, plan=True, chunk_size=4096,
+             time_chunk=2000, quiet=False):
+    """Simulate a population on one or more scenes.
+
+    Parameters
+    ----------
+    population : Population
+        From `sample_population` or `make_population`.
+    scenes : Scene or sequence of Scene
+        One condition per scene; all share one sample rate.
+    engine : {"brian2", "direct"}
+        Simulation engine; both give identical spikes.
+    dt : float
+        Integration step in seconds (default 0.1 ms).
+    method : str
+        Integration scheme.
+    trials : int
+        Trials per condition (noise differs between trials).
+    seed : int, numpy Generator or None
+        Root of every noise stream; recorded in the dataset's attrs.
+    record : sequence of str
+        Optional variables: ``"spikes"`` (events) and ``"forces"``.
+    no_shear : {"pass", "block"}
+        Reading of eq. 17.
+    types : sequence of str, optional
+        Afferent types to simulate (default: all).
+    plan : bool
+        Skip what provably does not matter (default); False runs everything.
+    chunk_size, time_chunk : int
+        Afferents and samples per chunk (results do not depend on them).
+    quiet : bool
+        Hide the progress bar (shown on stderr for runs over about a second).
+
+    Returns
+    -------
+    xarray.Dataset
+        See `population.dataset.build_dataset` for the schema.
+
+    Examples
+    --------
+    >>> from population import sample_population, birznieks
+    >>> pop = sample_population("fingertip", rng=0)
+    >>> ds = simulate(pop, [birznieks(90.0)], engine="direct", seed=1, quiet=True)
+    >>> ds.spike_count.dims
+    ('condition', 'trial', 'afferent')
+    """
+    from tqdm import tqdm
+
+    from .dataset import build_dataset
+
+    scenes = _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_size, time_chunk)
+    config = SimConfig(engine, float(dt), method, no_shear, root_seed(seed), int(time_chunk))
+    the_plan = plan_run(population, scenes, trials=trials, record=record, no_shear=no_shear, types=types,
+                        chunk_size=chunk_size, time_chunk=time_chunk, plan=plan)
+    spikes = [[] for _ in scenes]
+    members = [_unit_members(cond) for cond in the_plan.conditions]
+    with tqdm(total=the_plan.work(), unit="aff-sample", unit_scale=True, delay=1.0, file=sys.stderr,
+              disable=quiet, leave=False) as bar:
+        for c, job, block, deterministic in _jobs(population, scenes, the_plan):
+            result = run_chunk(job, config, progress=bar.update)
+            spikes[c].append(_expand(the_plan.conditions[c], members[c], the_plan, block, deterministic, result))
+    return build_dataset(population, scenes, the_plan, spikes, config)

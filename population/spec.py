@@ -1,0 +1,384 @@
+"""Population specs: per afferent type, how many, where, how tuned, how noisy.
+
+A spec is a TOML file or the matching frozen dataclasses.  Unknown keys,
+negative counts, NAP fractions that do not sum to 1 and unknown distributions
+are rejected with a `ValueError` naming the key.  Two presets ship inside the
+package: ``fingertip`` (TouchSim's index-fingertip pad) and ``hand``
+(TouchSim's whole hand).
+
+Frame: +X radial, +Y distal (mm, fingertip frame), so theta = 0 deg is radial,
+90 deg distal, 180 deg ulnar and 270 deg proximal.
+
+TOML layout (every table optional unless marked)::
+
+    name = "fingertip"
+    [region]                       # ellipse in mm
+    center_mm = [0.0, 0.0]
+    semi_axes_mm = [7.0, 9.0]      # radial, distal
+    [current]                      # overrides of models.CurrentParams
+    g_sai = 5.367
+    [types.SAI]                    # one table per type present
+    count = 282                    # or density_per_cm2 = 70.0
+    noise_sigma = 1.0              # mV/sqrt(ms)
+    gain_cv = 0.2                  # per-afferent gain spread (lognormal CV)
+    theta_t = { distribution = "von_mises", mean_deg = 90.0, kappa = 0.6 }
+    nap = { selective = 0.4, broad = 0.3, bipolar = 0.1, none = 0.2 }
+    [types.SAI.sharpness.selective]
+    distribution = "uniform"       # fixed | uniform | list
+    of = "theta_a"                 # theta_a (deg) or k
+    low = 20.0
+    high = 50.0
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+from models.attenuation import UNTUNED
+from models.currents import AFFERENT_TYPES, CurrentParams
+from models.nap import PROFILE_NAMES
+
+__all__ = [
+    "NAP_CHOICES",
+    "AngleDistribution",
+    "SharpnessDistribution",
+    "Region",
+    "TypeSpec",
+    "PopulationSpec",
+    "PRESETS",
+    "load_spec",
+    "spec_from_dict",
+]
+
+#: NAP choices of a population: the three profiles and "none" (untuned, CMM).
+NAP_CHOICES = PROFILE_NAMES + (UNTUNED,)
+PRESETS = ("fingertip", "hand")
+_ANGLE_KINDS = ("uniform", "von_mises", "fixed", "list")
+_SHARP_KINDS = ("fixed", "uniform", "list")
+
+
+def _fail(key: str, message: str):
+    raise ValueError(f"{key}: {message}")
+
+
+def _finite(key: str, value, *, positive=False, nonneg=False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        _fail(key, f"must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value) or (positive and value <= 0) or (nonneg and value < 0):
+        need = "> 0" if positive else ">= 0" if nonneg else "finite"
+        _fail(key, f"must be {need}, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class AngleDistribution:
+    """Distribution of tuning angles theta_T (degrees).
+
+    Attributes
+    ----------
+    distribution : {"uniform", "von_mises", "fixed", "list"}
+        Uniform on the circle; a von Mises mixture (``mean_deg`` may list
+        several means, with ``weights``); one fixed angle (``value_deg``); or
+        an explicit list cycled over the afferents (``values_deg``).
+    mean_deg : tuple of float
+        Von Mises mean(s) in degrees.
+    kappa : float
+        Von Mises concentration (dimensionless, >= 0; 0 is uniform).
+    weights : tuple of float
+        Mixture weights (default equal).
+    value_deg : float
+        The fixed angle.
+    values_deg : tuple of float
+        The explicit angles.
+    """
+
+    distribution: str = "uniform"
+    mean_deg: tuple = (0.0,)
+    kappa: float = 0.0
+    weights: tuple = ()
+    value_deg: float = 0.0
+    values_deg: tuple = ()
+
+    def __post_init__(self):
+        key = "theta_t"
+        if self.distribution not in _ANGLE_KINDS:
+            _fail(f"{key}.distribution", f"unknown distribution {self.distribution!r}; allowed: {', '.join(_ANGLE_KINDS)}")
+        means = self.mean_deg if isinstance(self.mean_deg, (tuple, list)) else (self.mean_deg,)
+        object.__setattr__(self, "mean_deg", tuple(_finite(f"{key}.mean_deg", m) for m in means))
+        _finite(f"{key}.kappa", self.kappa, nonneg=True)
+        weights = tuple(_finite(f"{key}.weights", w, nonneg=True) for w in self.weights)
+        if weights and (len(weights) != len(self.mean_deg) or not math.isclose(sum(weights), 1.0, abs_tol=1e-6)):
+            _fail(f"{key}.weights", f"need one weight per mean, summing to 1; got {weights}")
+        object.__setattr__(self, "weights", weights)
+        _finite(f"{key}.value_deg", self.value_deg)
+        object.__setattr__(self, "values_deg", tuple(_finite(f"{key}.values_deg", v) for v in self.values_deg))
+        if self.distribution == "list" and not self.values_deg:
+            _fail(f"{key}.values_deg", "a list distribution needs at least one angle")
+
+
+@dataclass(frozen=True)
+class SharpnessDistribution:
+    """Distribution of NAP sharpness, given as theta_A (degrees) or as k.
+
+    Attributes
+    ----------
+    distribution : {"fixed", "uniform", "list"}
+        One value, uniform on [low, high], or an explicit list cycled.
+    of : {"theta_a", "k"}
+        Whether the numbers are selectivity ranges theta_A in degrees
+        (converted by eq. 12) or sharpness k.
+    value, low, high : float
+        Parameters of the fixed and uniform forms.
+    values : tuple of float
+        The explicit values.
+    """
+
+    distribution: str = "fixed"
+    of: str = "k"
+    value: float = 3.0
+    low: float = 0.0
+    high: float = 0.0
+    values: tuple = ()
+
+    def __post_init__(self):
+        if self.distribution not in _SHARP_KINDS:
+            _fail("sharpness.distribution", f"unknown distribution {self.distribution!r}; allowed: {', '.join(_SHARP_KINDS)}")
+        if self.of not in ("theta_a", "k"):
+            _fail("sharpness.of", f"must be 'theta_a' or 'k', got {self.of!r}")
+        for name in ("value", "low", "high"):
+            _finite(f"sharpness.{name}", getattr(self, name))
+        object.__setattr__(self, "values", tuple(_finite("sharpness.values", v) for v in self.values))
+        if self.distribution == "uniform" and not self.low < self.high:
+            _fail("sharpness", f"uniform needs low < high, got low={self.low!r}, high={self.high!r}")
+        if self.distribution == "list" and not self.values:
+            _fail("sharpness.values", "a list distribution needs at least one value")
+
+
+#: Default sharpness per profile: the paper's k = 3 (broad needs k >= 1.8).
+DEFAULT_SHARPNESS = {name: SharpnessDistribution(value=3.0) for name in PROFILE_NAMES}
+
+
+@dataclass(frozen=True)
+class Region:
+    """An ellipse on the fingertip (mm): centre and semi-axes along X (radial) and Y (distal)."""
+
+    center_mm: tuple = (0.0, 0.0)
+    semi_axes_mm: tuple = (7.0, 9.0)
+
+    def __post_init__(self):
+        if len(self.center_mm) != 2 or len(self.semi_axes_mm) != 2:
+            _fail("region", "center_mm and semi_axes_mm need two numbers each")
+        object.__setattr__(self, "center_mm", tuple(_finite("region.center_mm", v) for v in self.center_mm))
+        object.__setattr__(self, "semi_axes_mm",
+                           tuple(_finite("region.semi_axes_mm", v, positive=True) for v in self.semi_axes_mm))
+
+    @property
+    def area_cm2(self) -> float:
+        """Area of the ellipse in cm^2."""
+        a, b = self.semi_axes_mm
+        return math.pi * a * b / 100.0
+
+
+@dataclass(frozen=True)
+class TypeSpec:
+    """How the afferents of one type are drawn.
+
+    Attributes
+    ----------
+    count : int or None
+        Number of afferents; give this or ``density_per_cm2``.
+    density_per_cm2 : float or None
+        Afferents per cm^2 over the spec's region.
+    theta_t : AngleDistribution
+        Tuning-angle distribution.
+    nap : dict
+        Fractions of ``selective``, ``broad``, ``bipolar`` and ``none`` (sum 1).
+    sharpness : dict
+        `SharpnessDistribution` per profile (default: k = 3).
+    gain_cv : float
+        Coefficient of variation of the per-afferent gain (lognormal, mean 1).
+    noise_sigma : float
+        White current-noise intensity in mV/sqrt(ms): each current sample of
+        length h ms gets ``noise_sigma * N(0, 1) / sqrt(h)``, so the voltage
+        noise over any interval is independent of the sampling.
+    """
+
+    count: int | None = None
+    density_per_cm2: float | None = None
+    theta_t: AngleDistribution = AngleDistribution()
+    nap: dict = field(default_factory=lambda: {UNTUNED: 1.0})
+    sharpness: dict = field(default_factory=lambda: dict(DEFAULT_SHARPNESS))
+    gain_cv: float = 0.0
+    noise_sigma: float = 0.0
+
+    def __post_init__(self):
+        if (self.count is None) == (self.density_per_cm2 is None):
+            _fail("count", "give exactly one of count and density_per_cm2")
+        if self.count is not None and (isinstance(self.count, bool) or not isinstance(self.count, int) or self.count < 0):
+            _fail("count", f"must be a whole number >= 0, got {self.count!r}")
+        if self.density_per_cm2 is not None:
+            _finite("density_per_cm2", self.density_per_cm2, nonneg=True)
+        for name in self.nap:
+            if name not in NAP_CHOICES:
+                _fail(f"nap.{name}", f"unknown NAP; allowed: {', '.join(NAP_CHOICES)}")
+        fracs = {k: _finite(f"nap.{k}", v, nonneg=True) for k, v in self.nap.items()}
+        if not math.isclose(sum(fracs.values()), 1.0, abs_tol=1e-6):
+            _fail("nap", f"fractions must sum to 1, got {sum(fracs.values())!r}")
+        object.__setattr__(self, "nap", fracs)
+        sharp = dict(DEFAULT_SHARPNESS, **self.sharpness)
+        for name in sharp:
+            if name not in PROFILE_NAMES:
+                _fail(f"sharpness.{name}", f"unknown profile; allowed: {', '.join(PROFILE_NAMES)}")
+        object.__setattr__(self, "sharpness", sharp)
+        _finite("gain_cv", self.gain_cv, nonneg=True)
+        _finite("noise_sigma", self.noise_sigma, nonneg=True)
+
+    def n_afferents(self, region: Region) -> int:
+        """Count, or density times the region's area, rounded."""
+        if self.count is not None:
+            return self.count
+        return int(round(self.density_per_cm2 * region.area_cm2))
+
+
+@dataclass(frozen=True)
+class PopulationSpec:
+    """A population: types, region, current parameters.
+
+    Attributes
+    ----------
+    name : str
+        Label stored in datasets.
+    types : dict
+        `TypeSpec` per afferent type (``"SAI"``, ``"RAI"``, ``"RAII"``).
+    region : Region
+        Where afferents are placed (uniformly), in mm.
+    current : CurrentParams
+        Gains and derivative filter of eqs 1-3.
+    description : str
+        Free text.
+    """
+
+    name: str = "custom"
+    types: dict = field(default_factory=dict)
+    region: Region = Region()
+    current: CurrentParams = CurrentParams()
+    description: str = ""
+
+    def __post_init__(self):
+        for kind in self.types:
+            if kind not in AFFERENT_TYPES:
+                _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)}")
+        ordered = {k: self.types[k] for k in AFFERENT_TYPES if k in self.types}
+        object.__setattr__(self, "types", ordered)
+
+    def n_afferents(self) -> dict:
+        """Afferents per type."""
+        return {k: t.n_afferents(self.region) for k, t in self.types.items()}
+
+    def replace(self, **changes) -> "PopulationSpec":
+        """A copy with fields replaced (see `dataclasses.replace`)."""
+        return dataclasses.replace(self, **changes)
+
+
+def _build(cls, data: dict, key: str, nested=None):
+    """Build dataclass ``cls`` from ``data``, naming any unknown key."""
+    if not isinstance(data, dict):
+        _fail(key, f"must be a table, got {type(data).__name__}")
+    allowed = {f.name for f in dataclasses.fields(cls)}
+    for name in data:
+        if name not in allowed:
+            _fail(f"{key}.{name}" if key else name, f"unknown key; allowed: {', '.join(sorted(allowed))}")
+    kwargs = dict(data)
+    for name, builder in (nested or {}).items():
+        if name in kwargs:
+            kwargs[name] = builder(kwargs[name], f"{key}.{name}" if key else name)
+    for name, value in kwargs.items():
+        if isinstance(value, list):
+            kwargs[name] = tuple(value)
+    try:
+        return cls(**kwargs)
+    except ValueError as exc:
+        raise ValueError(f"{key}.{exc}" if key and not str(exc).startswith(key) else str(exc)) from None
+
+
+def _type_spec(data, key):
+    def sharpness(d, k):
+        if not isinstance(d, dict):
+            _fail(k, "must be a table of profiles")
+        return {name: _build(SharpnessDistribution, v, f"{k}.{name}") for name, v in d.items()}
+
+    return _build(TypeSpec, data, key, {
+        "theta_t": lambda d, k: _build(AngleDistribution, d, k),
+        "sharpness": sharpness,
+    })
+
+
+def spec_from_dict(data: dict, *, default_name: str = "custom") -> PopulationSpec:
+    """Build a `PopulationSpec` from the TOML structure (a dict).
+
+    Raises
+    ------
+    ValueError
+        Naming the first unknown key or invalid value.
+
+    Examples
+    --------
+    >>> spec = spec_from_dict({"types": {"SAI": {"count": 10}}})
+    >>> spec.n_afferents()
+    {'SAI': 10}
+    """
+    data = dict(data)
+    data.setdefault("name", default_name)
+    types = data.get("types", {})
+    if not isinstance(types, dict) or not types:
+        _fail("types", "a spec needs at least one afferent type table, e.g. [types.SAI]")
+    for kind in types:
+        if kind not in AFFERENT_TYPES:
+            _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)}")
+    return _build(PopulationSpec, data, "", {
+        "types": lambda d, k: {kind: _type_spec(t, f"types.{kind}") for kind, t in d.items()},
+        "region": lambda d, k: _build(Region, d, "region"),
+        "current": lambda d, k: _build(CurrentParams, d, "current"),
+    })
+
+
+def load_spec(source) -> PopulationSpec:
+    """Load a preset by name (``"fingertip"``, ``"hand"``) or a spec from a TOML path.
+
+    Raises
+    ------
+    ValueError
+        For an unknown preset, a missing file, invalid TOML or an invalid spec.
+
+    Examples
+    --------
+    >>> load_spec("fingertip").n_afferents()
+    {'SAI': 282, 'RAI': 573, 'RAII': 100}
+    """
+    if isinstance(source, PopulationSpec):
+        return source
+    if isinstance(source, str) and source in PRESETS:
+        text = resources.files("population").joinpath("presets", f"{source}.toml").read_text()
+        name = source
+    else:
+        path = Path(source)
+        if path.suffix != ".toml":
+            raise ValueError(f"population={str(source)!r}: give a preset ({', '.join(PRESETS)}) or a .toml file")
+        try:
+            text = path.read_text()
+        except OSError as exc:
+            raise ValueError(f"population file {str(path)!r} cannot be read: {exc.strerror}") from None
+        name = path.stem
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"population file {name!r} is not valid TOML: {exc}") from None
+    return spec_from_dict(data, default_name=name)
+
+
