@@ -11,7 +11,7 @@ from population import (Contact, birznieks, describe_dataset, from_csv, load_dat
 
 from .io import ensure_out_dir, save_figure
 
-__all__ = ["register", "scenes_from_args", "write_plots"]
+__all__ = ["register", "register_demo", "scenes_from_args", "write_plots"]
 
 SCENES = ("birznieks", "press-push-lift", "rotating-shear")
 
@@ -47,6 +47,7 @@ def register(sub) -> None:
     p.add_argument("file")
     p.add_argument("--out", required=True, metavar="DIR")
     p.set_defaults(func=run_plot)
+    register_demo(sub)
 
 
 def _directions(text, default="90"):
@@ -100,11 +101,20 @@ def _population(args):
 
 
 def _check_out_file(path) -> Path:
+    """Fail before simulating if ``path`` cannot be written (a probe file is created)."""
+    import tempfile
+
     path = Path(path)
     if path.suffix != ".nc":
         raise ValueError(f"--out {str(path)!r} must end in .nc")
     if not path.parent.is_dir():
         raise ValueError(f"--out {str(path)!r}: directory {str(path.parent)!r} does not exist")
+    try:
+        with tempfile.NamedTemporaryFile(dir=path.parent, prefix=".ddmm-probe-"):
+            pass
+    except OSError as exc:
+        raise ValueError(f"--out {str(path)!r}: directory {str(path.parent)!r} is not writable "
+                         f"({exc.strerror})") from None
     return path
 
 
@@ -147,4 +157,32 @@ def write_plots(ds, out_dir) -> list:
 def run_plot(args) -> int:
     for path in write_plots(load_dataset(args.file), args.out):
         print(f"wrote {path}")
+    return 0
+
+
+def register_demo(sub) -> None:
+    """Add ``ddmm demo``."""
+    p = sub.add_parser("demo", help="the main job: fingertip population on press-push-lift, data and figures")
+    p.add_argument("--out", default="ddmm-demo", metavar="DIR", help="output directory (default ./ddmm-demo)")
+    p.add_argument("--engine", choices=("brian2", "direct"), default="brian2")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--quiet", action="store_true")
+    p.set_defaults(func=run_demo)
+
+
+def run_demo(args) -> int:
+    out_dir = ensure_out_dir(args.out)
+    pop = sample_population(load_spec("fingertip"), rng=args.seed)
+    scene = press_push_lift(90.0)
+    start = time.perf_counter()
+    ds = simulate(pop, scene, engine=args.engine, seed=args.seed, quiet=args.quiet)
+    wall = time.perf_counter() - start
+    path = save_dataset(ds, out_dir / "demo.nc")
+    figures = write_plots(ds, out_dir)
+    print(f"# ddmm demo: {len(pop)} fingertip afferents on press-push-lift (theta_R = 90 deg, distal push)\n")
+    print(describe_dataset(ds))
+    print(f"\nsimulated {len(pop) * scene.duration:,.0f} afferent-seconds in {wall:.2f} s ({args.engine} engine)")
+    print(f"wrote {path}")
+    for fig in figures:
+        print(f"wrote {fig}")
     return 0

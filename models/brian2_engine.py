@@ -31,6 +31,7 @@ import gc
 import hashlib
 import os
 import sys
+import threading
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -83,6 +84,7 @@ class _Build:
 
 
 _ACTIVE: _Build | None = None
+_LOCK = threading.RLock()  # Brian2's device is process-global: one run at a time
 
 
 def _pad(n: int, quantum: int) -> int:
@@ -220,6 +222,11 @@ def run_brian2(current, substeps, dt, params, v, u, method="euler", v_peak=30.0)
     """
     if v_peak != 30.0:
         raise ValueError(f"v_peak={v_peak!r}: the Brian2 engine is built for the paper's 30 mV")
+    with _LOCK:
+        return _run_locked(current, substeps, dt, params, v, u, method)
+
+
+def _run_locked(current, substeps, dt, params, v, u, method):
     n_samples_total, n_neurons = current.shape
     n_pad = _pad(n_neurons, _NEURON_QUANTUM)
     chunk = max(_SAMPLE_QUANTUM, (_MAX_ELEMENTS // n_pad) // _SAMPLE_QUANTUM * _SAMPLE_QUANTUM)

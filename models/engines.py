@@ -16,7 +16,7 @@ import numpy as np
 from ._validation import as_finite_array, check_choice, check_positive
 from .neuron import V_PEAK, NeuronParams, neuron_arrays, resting_state
 
-__all__ = ["ENGINES", "METHODS", "NeuronState", "SpikeResult", "substeps_for", "integrate"]
+__all__ = ["ENGINES", "METHODS", "NeuronState", "SpikeResult", "substeps_for", "prepare", "integrate"]
 
 ENGINES = ("brian2", "direct")
 METHODS = ("euler",)
@@ -82,6 +82,22 @@ def substeps_for(fs: float, dt: float) -> int:
             f"dt={dt!r} s must divide the sample interval 1/fs = {1.0 / fs!r} s a whole number of times"
         )
     return n
+
+
+def prepare(engine: str) -> None:
+    """Import an engine's heavy modules now, in the calling (main) thread.
+
+    ``import brian2`` installs a SIGINT handler, which Python allows only in
+    the main thread; callers that integrate from worker threads call this
+    first.
+    """
+    check_choice(engine, "engine", ENGINES)
+    if engine == "brian2":
+        from .brian2_engine import _import_brian2
+
+        _import_brian2()
+    else:
+        from . import direct  # noqa: F401 - loads numba and the kernels
 
 
 def _initial_state(state, b, n):

@@ -15,7 +15,7 @@ import numpy as np
 
 from models.attenuation import UNTUNED
 from models.currents import AFFERENT_TYPES, CurrentParams
-from models.nap import k_from_selectivity, validate_k
+from models.nap import PROFILE_NAMES, k_from_selectivity, validate_k
 
 from .spec import NAP_CHOICES, AngleDistribution, PopulationSpec, SharpnessDistribution, TypeSpec, load_spec
 
@@ -101,7 +101,7 @@ def _validate_values(pop: Population) -> None:
             raise ValueError(f"population {name} must be finite")
     if np.any(pop.gain < 0) or np.any(pop.noise_sigma < 0):
         raise ValueError("population gain and noise_sigma must be >= 0")
-    for profile in set(pop.nap.tolist()) - {UNTUNED}:
+    for profile in PROFILE_NAMES:
         validate_k(pop.k[pop.nap == profile], profile)
     if len(np.unique(pop.afferent_id)) != len(pop):
         raise ValueError("population afferent_id values must be unique")
@@ -149,8 +149,10 @@ def _sample_type(kind: str, spec: TypeSpec, region, rng) -> dict:
     nap = np.array(_apportion(spec.nap, n), dtype=object)
     nap = nap[rng.permutation(n)] if n else nap
     k = np.zeros(n)
-    for profile in set(nap.tolist()) - {UNTUNED}:
+    for profile in PROFILE_NAMES:  # a fixed order: draws must not depend on hash seeds
         idx = np.flatnonzero(nap == profile)
+        if idx.size == 0:
+            continue
         k[idx] = _sample_k(spec.sharpness[profile], profile, idx.size, rng)
     s2 = np.log1p(spec.gain_cv**2)
     gain = rng.lognormal(-s2 / 2.0, np.sqrt(s2), n) if spec.gain_cv > 0 else np.ones(n)

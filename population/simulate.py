@@ -12,6 +12,7 @@ spike.
 from __future__ import annotations
 
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,7 +20,7 @@ import numpy as np
 from models._validation import check_choice, check_positive
 from models.attenuation import NO_SHEAR_READINGS, UNTUNED, attenuated_force, attenuation_factor
 from models.currents import afferent_current
-from models.engines import ENGINES, METHODS, integrate, substeps_for
+from models.engines import ENGINES, METHODS, integrate, prepare, substeps_for
 
 from .noise import draw_noise, noise_streams, root_seed
 from .plan import RECORD_CHOICES, make_plan
@@ -27,6 +28,8 @@ from .sampling import Population
 from .scenes import Scene
 
 __all__ = ["SimConfig", "ChunkJob", "run_chunk", "simulate", "plan_run"]
+
+_PIPELINE = 2  # afferent blocks in flight at once
 
 
 @dataclass(frozen=True)
@@ -298,9 +301,15 @@ def simulate(population, scenes, *, engine="brian2", dt=1e-4, method="euler", tr
                         chunk_size=chunk_size, time_chunk=time_chunk, plan=plan)
     spikes = [[] for _ in scenes]
     members = [_unit_members(cond) for cond in the_plan.conditions]
+    prepare(engine)  # engine imports that must happen in the main thread
     with tqdm(total=the_plan.work(), unit="aff-sample", unit_scale=True, delay=1.0, file=sys.stderr,
-              disable=quiet, leave=False) as bar:
-        for c, job, block, deterministic in _jobs(population, scenes, the_plan):
-            result = run_chunk(job, config, progress=bar.update)
-            spikes[c].append(_expand(the_plan.conditions[c], members[c], the_plan, block, deterministic, result))
+              disable=quiet, leave=False) as bar, ThreadPoolExecutor(max_workers=_PIPELINE) as pool:
+        # Two blocks in flight: one block's currents and noise (numpy) are
+        # computed while the other integrates (numba threads, or the Brian2
+        # binary in its own process).  Blocks are independent, so the order
+        # of completion cannot change a spike.
+        running = [(c, block, det, pool.submit(run_chunk, job, config, bar.update))
+                   for c, job, block, det in _jobs(population, scenes, the_plan)]
+        for c, block, det, future in running:
+            spikes[c].append(_expand(the_plan.conditions[c], members[c], the_plan, block, det, future.result()))
     return build_dataset(population, scenes, the_plan, spikes, config)

@@ -335,6 +335,10 @@ def spec_from_dict(data: dict, *, default_name: str = "custom") -> PopulationSpe
     """
     data = dict(data)
     data.setdefault("name", default_name)
+    allowed = {f.name for f in dataclasses.fields(PopulationSpec)}
+    for name in data:
+        if name not in allowed:
+            _fail(name, f"unknown key; allowed: {', '.join(sorted(allowed))}")
     types = data.get("types", {})
     if not isinstance(types, dict) or not types:
         _fail("types", "a spec needs at least one afferent type table, e.g. [types.SAI]")

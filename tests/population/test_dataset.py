@@ -1,0 +1,32 @@
+"""Dataset helpers: binned rates and PSTHs against hand counts."""
+
+import numpy as np
+import pytest
+
+from population import binned_counts, birznieks, make_population, psth, simulate
+
+
+@pytest.fixture(scope="module")
+def ds():
+    pop = make_population(["SAI", "SAI", "RAI"], [90.0, 270.0, 90.0], "selective")
+    return simulate(pop, [birznieks(90.0), birznieks(None)], engine="direct", trials=2, quiet=True)
+
+
+def test_binned_counts_sum_to_spike_counts(ds):
+    counts = binned_counts(ds, 0.05)
+    np.testing.assert_array_equal(counts.sum("bin").values, ds.spike_count.values)
+    assert counts.sizes["bin"] == 10 and counts.bin.values[0] == pytest.approx(0.025)
+
+
+def test_psth_is_mean_rate_per_type(ds):
+    rates = psth(ds, 0.1)
+    assert set(rates.afferent_type.values) == {"SAI", "RAI"}
+    sai = ds.spike_count.where(ds.afferent_type == "SAI", drop=True).mean(("trial", "afferent"))
+    np.testing.assert_allclose((rates.sel(afferent_type="SAI") * 0.1).sum("bin").values, sai.values)
+
+
+def test_rates_need_events(ds):
+    with pytest.raises(ValueError, match="bin_s"):
+        binned_counts(ds, 0.0)
+    with pytest.raises(ValueError, match="spike events"):
+        binned_counts(ds.drop_vars("spike_time"), 0.1)

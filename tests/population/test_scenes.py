@@ -1,0 +1,81 @@
+"""Scenes: the paper's stimuli, and recorded CSV data with its errors."""
+
+import numpy as np
+import pytest
+
+from population.scenes import Contact, Scene, birznieks, from_csv, press_push_lift, rotating_shear
+
+
+def test_birznieks():
+    s = birznieks(90.0)
+    assert s.duration == 0.5 and s.fs == 1000.0
+    assert s.fz.max() == pytest.approx(4.0)
+    assert s.fy.max() == pytest.approx(4.0 * np.tan(np.deg2rad(20.0)))
+    np.testing.assert_allclose(s.fx, 0.0, atol=1e-12)
+    assert [st.label for st in s.stages] == ["loading", "plateau", "unloading"]
+    assert birznieks(None).max_shear() == 0.0 and birznieks(None).name == "normal"
+
+
+def test_press_push_lift_stages():
+    s = press_push_lift()
+    t = s.time
+    assert s.fz[(t > 8) & (t < 15)].max() == pytest.approx(3.0)
+    assert s.fz[(t > 18) & (t < 25)].min() == pytest.approx(6.0)
+    assert np.all(s.fz[t < 5] == 0) and np.all(s.fz[t > 27.01] == 0)
+
+
+def test_rotating_shear_turns_once():
+    s = rotating_shear(period_s=1.0)
+    angle = np.unwrap(np.arctan2(s.fy, s.fx)[(s.time >= 0.125) & (s.time <= 1.125)])
+    assert np.ptp(angle) == pytest.approx(2 * np.pi, abs=0.05)
+
+
+def test_scene_validation():
+    with pytest.raises(ValueError, match="fz"):
+        Scene([0.0], [0.0], [-1.0])
+    with pytest.raises(ValueError, match="equal length"):
+        Scene([0.0, 1.0], [0.0], [0.0])
+    with pytest.raises(ValueError, match="fx"):
+        Scene([np.nan], [0.0], [0.0])
+    with pytest.raises(ValueError, match="radius"):
+        Contact(0.0, 0.0, 0.0)
+
+
+def write(tmp_path, text, name="f.csv"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_csv_resamples_100hz(tmp_path):
+    t = np.arange(0, 1.0, 0.01)
+    rows = "\n".join(f"{a:.2f},{0.0},{0.5 * a},{2 * a}" for a in t)
+    s = from_csv(write(tmp_path, "time,fx,fy,fz\n" + rows))
+    assert s.fs == 1000.0 and s.n_samples == 991
+    np.testing.assert_allclose(s.fz, 2 * s.time, atol=1e-12)
+
+
+def test_csv_column_mapping_and_units(tmp_path):
+    s = from_csv(write(tmp_path, "t_ms,Fx,Fy,Fz\n0,0,0,1\n10,0,0,2\n"),
+                 columns={"time": "t_ms", "fx": "Fx", "fy": "Fy", "fz": "Fz"}, time_scale=1e-3)
+    assert s.n_samples == 11 and s.fz[-1] == 2.0
+
+
+@pytest.mark.parametrize("text,match", [
+    ("time,fx,fy,fz\n0,0,0,1\n0,0,0,1\n", "strictly increasing"),
+    ("time,fx,fy,fz\n0,0,0,1\n0.01,nan,0,1\n", "non-finite"),
+    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,0,-2\n", "negative normal force"),
+    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,0\n", "unequal length"),
+    ("", "empty"),
+    ("time,fx,fy\n0,0,0\n", "no column 'fz'"),
+    ("time,fx,fy,fz\n", "no data rows"),
+    ("time,fx,fy,fz\n0,a,0,1\n", "not a number"),
+])
+def test_csv_errors(tmp_path, text, match):
+    with pytest.raises(ValueError, match=match):
+        from_csv(write(tmp_path, text))
+
+
+def test_csv_negative_fz_can_be_clipped(tmp_path):
+    s = from_csv(write(tmp_path, "time,fx,fy,fz\n0,0,0,-0.01\n0.01,0,0,1\n"), negative_fz="clip")
+    assert s.fz.min() == 0.0
