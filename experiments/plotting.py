@@ -10,7 +10,8 @@ from matplotlib.figure import Figure
 
 from models.currents import AFFERENT_TYPES
 
-__all__ = ["plot_response", "plot_sf_vs_theta", "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces"]
+__all__ = ["plot_response", "plot_sf_vs_theta", "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces",
+           "plot_dsi_histograms", "plot_preferred_rose", "plot_neurometric"]
 
 _TYPE_COLOURS = {"SAI": "tab:blue", "RAI": "tab:orange", "RAII": "tab:green"}
 
@@ -173,4 +174,60 @@ def plot_forces(ds) -> Figure:
         _plot_forces(ax, ds.time.values, forces)
         ax.set_title(str(ds.condition.values[c]), fontsize=9)
     axes[-1].set_xlabel("time (s)")
+    return fig
+
+
+def plot_dsi_histograms(tuning, reference: dict | None = None) -> Figure:
+    """DSI histogram per afferent type (responsive afferents), with the human mean +- SD."""
+    fig = Figure(figsize=(4.0 * len(AFFERENT_TYPES), 3.2), layout="constrained")
+    axes = fig.subplots(1, len(AFFERENT_TYPES), sharey=False, squeeze=False)[0]
+    for ax, kind in zip(axes, AFFERENT_TYPES):
+        sel = (tuning.afferent_type.values == kind) & (tuning.responsive.values == 1)
+        values = tuning.dsi.values[sel]
+        ax.hist(values, bins=np.linspace(0, 1, 21), color=_TYPE_COLOURS[kind], alpha=0.7)
+        if values.size:
+            ax.axvline(values.mean(), color="k", lw=1.5, label=f"model {values.mean():.2f} ± {values.std():.2f}")
+        if reference and kind in reference:
+            mean, sd = reference[kind]
+            ax.axvspan(max(0, mean - sd), mean + sd, color="grey", alpha=0.2, label=f"human {mean} ± {sd}")
+            ax.axvline(mean, color="grey", ls="--")
+        ax.set_title(f"{kind} (n = {values.size})")
+        ax.set_xlabel("DSI (eq. 7)")
+        ax.legend(fontsize=7)
+    axes[0].set_ylabel("afferents")
+    return fig
+
+
+def plot_preferred_rose(tuning, bins: int = 16) -> Figure:
+    """Rose plot of preferred directions of tuned afferents, per type (0 radial, 90 distal)."""
+    fig = Figure(figsize=(4.0 * len(AFFERENT_TYPES), 4.0), layout="constrained")
+    edges = np.linspace(0, 2 * np.pi, bins + 1)
+    for i, kind in enumerate(AFFERENT_TYPES):
+        ax = fig.add_subplot(1, len(AFFERENT_TYPES), i + 1, projection="polar")
+        sel = (tuning.afferent_type.values == kind) & (tuning.tuned.values == 1) & (tuning.has_preferred.values == 1)
+        counts, _ = np.histogram(np.deg2rad(tuning.preferred_deg.values[sel]), edges)
+        ax.bar(edges[:-1], counts, width=edges[1] - edges[0], align="edge", color=_TYPE_COLOURS[kind], alpha=0.7)
+        ax.set_xticks(np.deg2rad([0, 90, 180, 270]), ["radial", "distal", "ulnar", "proximal"])
+        ax.set_title(f"{kind}: preferred directions of {int(sel.sum())} tuned\n(vector sum; axial ones omitted)",
+                     fontsize=9, pad=14)
+    return fig
+
+
+def plot_neurometric(summary: dict, threshold: float | None = None) -> Figure:
+    """Median decoding error against population size (one line per window), per decoder."""
+    decoders = list(summary["errors"])
+    fig = Figure(figsize=(4.2 * len(decoders), 3.6), layout="constrained")
+    axes = fig.subplots(1, len(decoders), sharey=True, squeeze=False)[0]
+    for ax, name in zip(axes, decoders):
+        for window, by_n in summary["errors"][name].items():
+            sizes = sorted(by_n, key=int)
+            ax.plot([int(n) for n in sizes], [by_n[n]["median_deg"] for n in sizes], "o-", label=f"{window} ms")
+        if threshold is not None:
+            ax.axhline(threshold, color="k", ls="--", lw=1, label=f"human {threshold}°")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("afferents")
+        ax.set_title(name.replace("_", " "))
+    axes[0].set_ylabel("median |error| (deg)")
+    axes[-1].legend(fontsize=7)
     return fig

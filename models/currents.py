@@ -68,9 +68,11 @@ class CurrentParams:
     filter_order : int
         Order of that Butterworth filter (2 in the notes' trial).
     i_sat : float or None
-        Scale of the compressive transducer in mV/ms:
+        Scale of the compressive transducer in mV/ms, for every type:
         ``I = i_sat * log1p(g * x / i_sat)``, about ``g * x`` while
         ``g * x << i_sat``.  None: the paper's linear eqs 1-3 verbatim.
+    i_sat_sai, i_sat_rai, i_sat_raii : float or None
+        Per-type scales; when given they override ``i_sat`` for that type.
     """
 
     g_sai: float = 5.367  # fitted: CMM SAI SF 47.5 pulses/s (Table III)
@@ -79,12 +81,16 @@ class CurrentParams:
     cutoff_hz: float = 20.0
     filter_order: int = 2
     i_sat: float | None = None
+    i_sat_sai: float | None = None
+    i_sat_rai: float | None = None
+    i_sat_raii: float | None = None
 
     def __post_init__(self):
         for name in ("g_sai", "g_rai", "g_raii", "cutoff_hz"):
             check_positive(getattr(self, name), name)
-        if self.i_sat is not None:
-            check_positive(self.i_sat, "i_sat", "mV/ms")
+        for name in ("i_sat", "i_sat_sai", "i_sat_rai", "i_sat_raii"):
+            if getattr(self, name) is not None:
+                check_positive(getattr(self, name), name, "mV/ms")
         if not isinstance(self.filter_order, int) or not 1 <= self.filter_order <= 8:
             raise ValueError(f"filter_order must be an int in [1, 8], got {self.filter_order!r}")
 
@@ -92,6 +98,11 @@ class CurrentParams:
         """The gain of ``afferent_type`` (``"SAI"``, ``"RAI"`` or ``"RAII"``)."""
         check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
         return {"SAI": self.g_sai, "RAI": self.g_rai, "RAII": self.g_raii}[afferent_type]
+
+    def saturation(self, afferent_type: str) -> float | None:
+        """The transducer scale of ``afferent_type`` in mV/ms (None: linear)."""
+        own = {"SAI": self.i_sat_sai, "RAI": self.i_sat_rai, "RAII": self.i_sat_raii}[afferent_type]
+        return self.i_sat if own is None else own
 
 
 @dataclass(frozen=True)
@@ -256,18 +267,19 @@ def afferent_current(
     gain = params.gain(afferent_type)
     if scale is not None:
         gain = gain * np.asarray(scale, dtype=float)
+    i_sat = params.saturation(afferent_type)
     if afferent_type == "SAI":
-        return _saturate(gain * np.abs(f_a), params), None
+        return _saturate(gain * np.abs(f_a), i_sat), None
     if state is None:
         state = initial_filter_state(f_a[0], fs, params)
     dev, new_state = _filter_deviation(f_a, fs, params, state)
     order = 1 if afferent_type == "RAI" else 2
     deriv = _backward_differences(dev, fs, state, order)
-    return _saturate(gain * np.abs(deriv), params), new_state
+    return _saturate(gain * np.abs(deriv), i_sat), new_state
 
 
-def _saturate(drive, params: CurrentParams):
+def _saturate(drive, i_sat):
     """Compressive transduction of the linear drive (see the module docstring)."""
-    if params.i_sat is not None:
-        drive = params.i_sat * np.log1p(drive / params.i_sat)
+    if i_sat is not None:
+        drive = i_sat * np.log1p(drive / i_sat)
     return drive

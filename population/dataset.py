@@ -8,7 +8,8 @@ Schema (names are fixed):
   ``afferent_type``, ``theta_t`` (deg), ``nap``, ``k``, ``gain``, ``x_mm``,
   ``y_mm``, ``noise_sigma``; on ``condition``: ``condition`` (scene name),
   ``duration`` (s), ``theta_r`` (deg) with ``has_theta_r`` (1 when the scene
-  has one nominal shear direction); ``time`` (s);
+  has one nominal shear direction); ``time`` (s); ``stage`` (labels of the
+  scenes' phases, with ``stage_start``/``stage_end(condition, stage)`` in s);
 * data vars ``spike_count(condition, trial, afferent)``; the events
   ``spike_time`` (s), ``spike_afferent`` (position on ``afferent``),
   ``spike_trial`` and ``spike_condition`` (positions), sorted by condition,
@@ -55,7 +56,8 @@ def model_attrs(population, config) -> dict:
         "f_th": F_TH, "contact_threshold": CONTACT_THRESHOLD, "v_peak": V_PEAK,
         "current_g_sai": cp.g_sai, "current_g_rai": cp.g_rai, "current_g_raii": cp.g_raii,
         "current_cutoff_hz": cp.cutoff_hz, "current_filter_order": cp.filter_order,
-        "current_i_sat": "none" if cp.i_sat is None else cp.i_sat,
+        **{f"current_i_sat_{t.lower()}": "none" if cp.saturation(t) is None else cp.saturation(t)
+           for t in ("SAI", "RAI", "RAII")},
         "noise_model": "white Gaussian current, sigma/sqrt(h) per sample of h ms",
         "rf_support": RF_SUPPORT,
     }
@@ -81,6 +83,21 @@ def _afferent_coords(population, index) -> dict:
         "noise_sigma": ("afferent", pop.noise_sigma[index].astype(float), {"units": "mV/sqrt(ms)"}),
     }
     return {k: xr.Variable(*v) for k, v in coords.items()}
+
+
+def _stage_vars(scenes) -> dict:
+    """Stage boundaries per condition (s); a stage a scene lacks is the empty [0, 0)."""
+    labels = list(dict.fromkeys(st.label for s in scenes for st in s.stages))
+    start = np.zeros((len(scenes), len(labels)))
+    end = np.zeros((len(scenes), len(labels)))
+    for c, scene in enumerate(scenes):
+        for st in scene.stages:
+            start[c, labels.index(st.label)] = st.start
+            end[c, labels.index(st.label)] = st.end
+    coord = xr.Variable("stage", np.array(labels, dtype=object), {"units": "1"})
+    return {"stage": coord,
+            "stage_start": xr.Variable(("condition", "stage"), start, {"units": "s"}),
+            "stage_end": xr.Variable(("condition", "stage"), end, {"units": "s"})}
 
 
 def _condition_coords(scenes) -> dict:
@@ -123,6 +140,10 @@ def build_dataset(population, scenes, plan, spikes, config) -> xr.Dataset:
             data[name] = xr.Variable("spike", arr.astype(np.int32), {"units": "1", "note": "position index"})
     coords = {**_afferent_coords(population, plan.selected[plan.keep]), **_condition_coords(scenes),
               "trial": xr.Variable("trial", np.arange(n_t, dtype=np.int64), {"units": "1"})}
+    if any(s.stages for s in scenes):
+        stages = _stage_vars(scenes)
+        coords["stage"] = stages.pop("stage")
+        data.update(stages)
     if "forces" in plan.record:
         n_time = max(s.n_samples for s in scenes)
         coords["time"] = xr.Variable("time", np.arange(n_time) / scenes[0].fs, {"units": "s"})

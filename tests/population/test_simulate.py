@@ -9,7 +9,8 @@ from population import (Contact, birznieks, load_dataset, make_population, plan_
 
 SCHEMA_COORDS = {"afferent", "afferent_type", "theta_t", "nap", "k", "gain", "x_mm", "y_mm", "noise_sigma",
                  "condition", "duration", "theta_r", "has_theta_r", "trial", "time"}
-SCHEMA_VARS = {"spike_count", "spike_time", "spike_afferent", "spike_trial", "spike_condition", "fx", "fy", "fz"}
+SCHEMA_VARS = {"spike_count", "spike_time", "spike_afferent", "spike_trial", "spike_condition", "fx", "fy", "fz",
+               "stage_start", "stage_end"}
 ATTRS = {"engine", "dt", "method", "seed", "no_shear", "ddmm_version", "f_th", "current_g_sai",
          "neuron_SAI_b", "rf_sigma_RAII_mm"}
 
@@ -30,7 +31,7 @@ def scenes():
 
 def test_schema(small):
     ds = simulate(small, scenes(), engine="direct", trials=2, seed=5, quiet=True)
-    assert set(ds.dims) == {"condition", "trial", "afferent", "spike", "time"}
+    assert set(ds.dims) == {"condition", "trial", "afferent", "spike", "time", "stage"}
     assert SCHEMA_COORDS <= set(ds.coords) and SCHEMA_VARS <= set(ds.data_vars)
     assert ds.spike_count.dims == ("condition", "trial", "afferent")
     assert ATTRS <= set(ds.attrs)

@@ -1,0 +1,70 @@
+"""ddmm tuning / decode / calibrate: JSON shapes, figures, targets."""
+
+import json
+
+import numpy as np
+import pytest
+
+from experiments.calibrate import spec_to_toml
+from experiments.cli import main
+from experiments.decoding import run_decoding, summarise
+from population import load_spec, spec_from_dict
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_tuning_json_and_figures(capsys, tmp_path):
+    code, out, _ = run(capsys, "tuning", "--population", "fingertip", "--seed", "2", "--json", "--out", tmp_path)
+    assert code == 0
+    result = json.loads(out)
+    assert set(result["tuned_fraction"]) == {"all", "SAI", "RAI", "RAII"}
+    assert set(result["dsi"]["SAI"]) == {"mean", "sd"} and "reference" in result
+    assert {"tuning.json", "dsi_histograms.png", "preferred_directions.png"} <= {p.name for p in tmp_path.iterdir()}
+
+
+def test_decode_json_shape(capsys, tmp_path):
+    code, out, _ = run(capsys, "decode", "--seed", "1", "--train", "40", "--test", "20", "--subsets", "1",
+                       "--json", "--out", tmp_path)
+    assert code == 0
+    result = json.loads(out)
+    assert set(result["errors"]) == {"population_vector", "maximum_likelihood", "first_spike_latency"}
+    by_window = result["errors"]["maximum_likelihood"]
+    assert list(by_window) == ["25", "50", "100", "125", "250"]
+    assert list(by_window["125"]) == ["10", "30", "100", "300", "955"]
+    assert set(by_window["125"]["955"]) == {"median_deg", "p90_deg"} and "reference" in result
+    assert (tmp_path / "neurometric.png").stat().st_size > 10_000
+
+
+def test_full_fingertip_decodes_within_human_threshold_in_125_ms():
+    summary = summarise(run_decoding("fingertip", seed=5, n_train=120, n_test=60, windows_ms=(125,), sizes=(None,)))
+    best = min(d["125"]["955"]["median_deg"] for d in summary["errors"].values())
+    assert best <= 7.1
+
+
+def test_bad_decode_options(capsys):
+    code, _, err = run(capsys, "decode", "--train", "0")
+    assert code == 2 and "--train" in err
+
+
+def test_calibrated_spec_round_trips_through_toml():
+    spec = load_spec("fingertip")
+    import tomllib
+    again = spec_from_dict(tomllib.loads(spec_to_toml(spec)))
+    assert again.current == spec.current and again.n_afferents() == spec.n_afferents()
+    for kind in spec.types:
+        assert again.types[kind].nap == pytest.approx(spec.types[kind].nap)
+
+
+@pytest.mark.slow
+def test_calibration_reproduces_the_committed_preset():
+    from experiments.calibrate import calibrate
+
+    spec, report = calibrate()
+    committed = load_spec("fingertip")
+    assert spec.current.i_sat_sai == pytest.approx(committed.current.i_sat_sai, rel=0.02)
+    assert spec.current.g_rai == pytest.approx(committed.current.g_rai, rel=0.02)
+    assert np.isclose(report["validation"]["mean_sd"]["tuned_fraction.all"][0], 0.86, atol=0.03)

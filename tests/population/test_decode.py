@@ -1,0 +1,95 @@
+"""Decoders: analytic cases, real spikes, and every bad input named."""
+
+import numpy as np
+import pytest
+
+from population import birznieks, make_population, sample_population, simulate
+from population.decode import (FirstSpikeLatency, MaximumLikelihood, PopulationVector, angular_error,
+                               select_afferents, window_responses)
+
+from .synthetic import cosine_dataset
+
+THETA_T = np.arange(0.0, 360.0, 7.5)  # 48 afferents, evenly tuned
+
+
+@pytest.fixture(scope="module")
+def train():
+    return cosine_dataset(np.arange(0.0, 360.0, 5.0), THETA_T, peak=400, base=100)
+
+
+@pytest.fixture(scope="module")
+def test_set():
+    return cosine_dataset(np.random.default_rng(0).uniform(0, 360, 40), THETA_T, peak=400, base=100)
+
+
+def test_angular_error_wraps():
+    np.testing.assert_allclose(angular_error([0, 359, 180, 90], [360, 1, 0, 270]), [0, 2, 180, 180])
+
+
+@pytest.mark.parametrize("decoder", [PopulationVector, MaximumLikelihood])
+def test_noiseless_cosine_population_decodes_within_1_degree(decoder, train, test_set):
+    decoded = decoder(0.2).fit(train).predict(test_set)
+    err = angular_error(decoded.values.ravel(), test_set.theta_r.values)
+    assert err.max() < 1.0
+    assert decoded.dims == ("condition", "trial") and decoded.attrs["units"] == "deg"
+
+
+def test_latency_decoder_on_cosine_latencies():
+    def lat(d):
+        return 0.02 - 0.01 * np.cos(d)  # first spike 10-30 ms after onset, earliest when aligned
+    train = cosine_dataset(np.arange(0.0, 360.0, 5.0), THETA_T, latency_s=lat)
+    test = cosine_dataset(np.random.default_rng(1).uniform(0, 360, 30), THETA_T, latency_s=lat)
+    decoded = FirstSpikeLatency(0.05).fit(train).predict(test)
+    assert angular_error(decoded.values.ravel(), test.theta_r.values).max() < 1.0
+
+
+def test_bipolar_afferents_are_axial_in_the_population_vector():
+    train = cosine_dataset(np.arange(0.0, 360.0, 5.0), THETA_T, peak=400, base=100)
+    pv = PopulationVector(0.2).fit(train)
+    assert np.allclose(np.abs(pv.axial_), 0.0) and np.allclose(np.abs(pv.unipolar_), 1.0)
+
+
+def test_window_responses_count_and_censor(train):
+    counts, latency = window_responses(train, 0.2)
+    assert counts.sum() == train.spike_count.values.sum()
+    short_counts, short_latency = window_responses(train, 0.001)
+    assert short_counts.sum() <= counts.sum() and np.all(short_latency <= 0.001)
+
+
+def test_select_afferents_remaps_events(train):
+    sub = select_afferents(train, [3, 10])
+    assert sub.sizes["afferent"] == 2 and set(np.unique(sub.spike_afferent.values)) <= {0, 1}
+    assert sub.spike_time.size == train.spike_count.values[..., [3, 10]].sum()
+
+
+def test_real_spikes_decode():
+    pop = sample_population("fingertip", rng=3).select(np.arange(0, 955, 3))
+    rng = np.random.default_rng(3)
+    scenes = lambda n, p: [__import__("dataclasses").replace(birznieks(float(d)), name=f"{p}{i}")  # noqa: E731
+                            for i, d in enumerate(rng.uniform(0, 360, n))]
+    train = simulate(pop, scenes(60, "a"), engine="direct", seed=1, quiet=True)
+    test = simulate(pop, scenes(30, "b"), engine="direct", seed=2, quiet=True)
+    for cls in (MaximumLikelihood, FirstSpikeLatency, PopulationVector):
+        err = angular_error(cls(0.125).fit(train).predict(test).values.ravel(), test.theta_r.values)
+        assert np.median(err) < 20.0, cls.name
+
+
+def test_bad_input(train, test_set):
+    few = cosine_dataset([0.0, 90.0, 180.0], THETA_T)
+    with pytest.raises(ValueError, match="needs at least 10 trials"):
+        MaximumLikelihood(0.1).fit(few)
+    with pytest.raises(ValueError, match="not fitted"):
+        MaximumLikelihood(0.1).predict(train)
+    fitted = MaximumLikelihood(0.1).fit(train)
+    with pytest.raises(ValueError, match="same population"):
+        fitted.predict(select_afferents(test_set, np.arange(10)))
+    with pytest.raises(ValueError, match="longer than condition"):
+        MaximumLikelihood(0.6).fit(train)
+    with pytest.raises(ValueError, match="window_s"):
+        PopulationVector(0.0)
+    no_forces = train.drop_vars("fz")
+    with pytest.raises(ValueError, match="forces"):
+        PopulationVector(0.1).fit(no_forces)
+    ds = simulate(make_population(["SAI"]), birznieks(None), engine="direct", quiet=True)
+    with pytest.raises(ValueError, match="distinct directions"):
+        MaximumLikelihood(0.1).fit(ds)
