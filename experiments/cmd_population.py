@@ -196,7 +196,7 @@ def _demo_biology(args, out_dir) -> list:
 
     tuning, summary = run_tuning_stats("fingertip", args.seed, engine=args.engine)
     frac = summary["tuned_fraction"]
-    print(f"\n## Direction tuning (5 force directions x 5 trials, ANOVA per phase, p < 0.05)\n")
+    print("\n## Direction tuning (5 force directions x 5 trials, ANOVA per phase, p < 0.05)\n")
     print(f"tuned: {100 * frac['all']:.1f}% of afferents (human: {100 * HUMAN_TUNED_FRACTION['all']:.0f}%); "
           f"SAI {100 * frac['SAI']:.1f}% (93%), RAI {100 * frac['RAI']:.1f}% (83%)")
     print("-> Like human recordings, the simulated fingertip is dominated by direction-tuned afferents. The SAI and "
@@ -205,7 +205,7 @@ def _demo_biology(args, out_dir) -> list:
                                     engine=args.engine, windows_ms=(25, 50, 125), sizes=(10, 30, 100, None)))
     ml = result["errors"]["maximum_likelihood"]["125"][str(len(tuning.afferent))]
     best = best_settings(result)
-    print(f"\n## Decoding shear direction (150 training, 100 test directions, uniform on the circle)\n")
+    print("\n## Decoding shear direction (150 training, 100 test directions, uniform on the circle)\n")
     print(f"median error {ml['median_deg']:.2f} deg (90th percentile {ml['p90_deg']:.2f}) from all "
           f"{len(tuning.afferent)} afferents within 125 ms of contact (maximum likelihood); human threshold "
           f"{HUMAN_DIRECTION_THRESHOLD_DEG} deg")

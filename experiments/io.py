@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from pathlib import Path
+
+from population._files import atomic_write
 
 __all__ = ["ensure_out_dir", "atomic_write", "save_figure", "save_json"]
 
@@ -26,25 +27,6 @@ def ensure_out_dir(path) -> Path:
     if not out.is_dir() or not os.access(out, os.W_OK):
         raise ValueError(f"--out {str(path)!r} is not a writable directory")
     return out
-
-
-def atomic_write(path, write) -> Path:
-    """Call ``write(tmp_path)`` then rename the temporary file onto ``path``.
-
-    The temporary file lives in the target's directory, so the rename is
-    atomic; on any error it is removed and ``path`` is left untouched.
-    """
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
 
 
 def save_figure(fig, path, dpi: int = 120) -> Path:

@@ -22,7 +22,6 @@ Schema (names are fixed):
 from __future__ import annotations
 
 import os
-import tempfile
 from importlib import metadata
 from pathlib import Path
 
@@ -33,6 +32,7 @@ from models.attenuation import F_TH
 from models.metrics import CONTACT_THRESHOLD
 from models.neuron import NEURON_PARAMS, V_PEAK
 
+from ._files import atomic_write
 from .spatial import RF_SIGMA_MM, RF_SUPPORT
 
 __all__ = ["build_dataset", "save_dataset", "load_dataset", "binned_counts", "binned_rates", "psth",
@@ -168,15 +168,7 @@ def save_dataset(ds: xr.Dataset, path) -> Path:
     directory = path.parent if str(path.parent) else Path(".")
     if not directory.is_dir() or not os.access(directory, os.W_OK):
         raise ValueError(f"cannot write {str(path)!r}: {str(directory)!r} is not a writable directory")
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".part")
-    os.close(fd)
-    try:
-        ds.to_netcdf(tmp, engine="h5netcdf")
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
+    return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
 
 
 def load_dataset(path) -> xr.Dataset:

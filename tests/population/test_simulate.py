@@ -154,3 +154,13 @@ def test_same_seed_same_spikes_across_processes():
     outs = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                            env={**os.environ, "PYTHONHASHSEED": str(h)}).stdout for h in (11, 12)}
     assert len(outs) == 1
+
+
+def test_saved_files_get_normal_permissions(small, tmp_path):
+    import os
+    import stat
+    ds = simulate(small, birznieks(90.0), engine="direct", seed=1, quiet=True)
+    path = save_dataset(ds, tmp_path / "run.nc")
+    mask = os.umask(0)
+    os.umask(mask)
+    assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~mask
