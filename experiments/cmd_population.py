@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import time
+import warnings
 from pathlib import Path
+
+from models.engines import SpikeCapWarning
 
 from population import (Contact, birznieks, describe_dataset, from_csv, load_dataset, load_spec,
                         plan_run, press_push_lift, psth, rotating_shear, sample_population,
@@ -23,7 +26,11 @@ def _add_run_options(p, *, out_required: bool) -> None:
                    help="shear direction(s) in degrees, one condition each ('none': normal only); default 90")
     p.add_argument("--contact", default=None, metavar="X,Y,R", help="contact centre and radius in mm")
     p.add_argument("--engine", choices=("brian2", "direct"), default="brian2")
-    p.add_argument("--dt", type=float, default=0.1, metavar="MS", help="integration step in ms (default 0.1)")
+    p.add_argument("--dt", type=float, default=None, metavar="MS", help="integration step in ms (default 0.1)")
+    p.add_argument("--method", choices=("euler", "rk2", "rk4", "izhikevich2003"), default=None,
+                   help="integration scheme (default euler)")
+    p.add_argument("--tolerance", type=float, default=None, metavar="PPS",
+                   help="choose the cheapest dt and method whose mean SF error is within PPS pulses/s")
     p.add_argument("--trials", type=int, default=1)
     p.add_argument("--seed", type=int, default=0, help="seed of the population and the noise (default 0)")
     p.add_argument("--no-shear", choices=("pass", "block"), default="pass")
@@ -122,12 +129,14 @@ def run_simulate(args) -> int:
     out = _check_out_file(args.out)
     pop, scenes = _population(args), scenes_from_args(args)
     start = time.perf_counter()
-    ds = simulate(pop, scenes, engine=args.engine, dt=args.dt * 1e-3, trials=args.trials, seed=args.seed,
+    ds = simulate(pop, scenes, engine=args.engine, dt=None if args.dt is None else args.dt * 1e-3,
+                  method=args.method, tolerance=args.tolerance, trials=args.trials, seed=args.seed,
                   no_shear=args.no_shear, types=_types(args.types), quiet=args.quiet)
     save_dataset(ds, out)
     if not args.quiet:
+        choice = f"; {ds.attrs['tolerance_choice']}" if "tolerance_choice" in ds.attrs else ""
         print(f"wrote {out} ({ds.sizes['afferent']} afferents, {ds.sizes['spike']} spikes, "
-              f"{time.perf_counter() - start:.2f} s)")
+              f"{time.perf_counter() - start:.2f} s{choice})")
     return 0
 
 
@@ -135,6 +144,12 @@ def run_plan(args) -> int:
     pop, scenes = _population(args), scenes_from_args(args)
     the_plan = plan_run(pop, scenes, trials=args.trials, no_shear=args.no_shear, types=_types(args.types))
     print(the_plan.describe(pop, scenes))
+    if args.tolerance is not None:
+        from population.accuracy import choose_setting
+
+        row = choose_setting(args.tolerance, scenes[0].fs)
+        print(f"tolerance {args.tolerance:g} pulses/s: dt={row['dt_ms']:g} ms, method={row['method']} "
+              f"(measured mean SF error {row['sf_err_mean']:.3g} pulses/s)")
     return 0
 
 
@@ -175,12 +190,22 @@ def run_demo(args) -> int:
     pop = sample_population(load_spec("fingertip"), rng=args.seed)
     scene = press_push_lift(90.0)
     start = time.perf_counter()
-    ds = simulate(pop, scene, engine=args.engine, seed=args.seed, quiet=args.quiet)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", SpikeCapWarning)
+        ds = simulate(pop, scene, engine=args.engine, seed=args.seed, quiet=args.quiet)
     wall = time.perf_counter() - start
     written = [save_dataset(ds, out_dir / "demo.nc"), *write_plots(ds, out_dir)]
     print(f"# ddmm demo: {len(pop)} fingertip afferents on press-push-lift (theta_R = 90 deg, distal push)\n")
     print(describe_dataset(ds))
     print(f"\nsimulated {len(pop) * scene.duration:,.0f} afferent-seconds in {wall:.2f} s ({args.engine} engine)")
+    capped = [w for w in caught if issubclass(w.category, SpikeCapWarning)]
+    if capped:
+        print(f"note: in {len(capped)} time block(s) a few afferents hit the one-spike-per-step cap: when shear "
+              "crosses F_TH under 3 N, eq. 17 steps F_A within one sample, a strong dynamic stimulus "
+              "(README, 'Which reading matches which entries')")
+    for w in caught:
+        if not issubclass(w.category, SpikeCapWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     written += _demo_biology(args, out_dir)
     for path in written:
         print(f"wrote {path}")

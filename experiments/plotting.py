@@ -11,7 +11,7 @@ from matplotlib.figure import Figure
 from models.currents import AFFERENT_TYPES
 
 __all__ = ["plot_response", "plot_sf_vs_theta", "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces",
-           "plot_dsi_histograms", "plot_preferred_rose", "plot_neurometric"]
+           "plot_dsi_histograms", "plot_preferred_rose", "plot_neurometric", "plot_pareto"]
 
 _TYPE_COLOURS = {"SAI": "tab:blue", "RAI": "tab:orange", "RAII": "tab:green"}
 
@@ -230,4 +230,32 @@ def plot_neurometric(summary: dict, threshold: float | None = None) -> Figure:
         ax.set_title(name.replace("_", " "))
     axes[0].set_ylabel("median |error| (deg)")
     axes[-1].legend(fontsize=7)
+    return fig
+
+
+def plot_pareto(rows) -> Figure:
+    """Mean SF error against wall time per afferent-second, one line per method and engine."""
+    fig = Figure(figsize=(7.0, 5.0), layout="constrained")
+    ax = fig.subplots()
+    markers = {"direct": "o", "brian2": "s"}
+    keys = sorted({(r["method"], r["engine"]) for r in rows})
+    for method, engine in keys:
+        sel = sorted((r for r in rows if r["method"] == method and r["engine"] == engine
+                      and r["sf_err_mean"] is not None), key=lambda r: r["dt_ms"])
+        if not sel:
+            continue
+        x = [r["wall_s_per_afferent_s"] * 1e6 for r in sel]
+        y = [max(r["sf_err_mean"], 1e-3) for r in sel]
+        ax.plot(x, y, marker=markers.get(engine, "o"), ls="-" if engine == "direct" else ":",
+                label=f"{method} ({engine})")
+        for r, xi, yi in zip(sel, x, y):
+            if engine == "direct":
+                ax.annotate(f"{r['dt_ms']:g}", (xi, yi), fontsize=6, xytext=(3, 3), textcoords="offset points")
+    ax.axhline(1.0, color="grey", ls="--", lw=1)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time per afferent-second (µs)")
+    ax.set_ylabel("mean |SF - SF_ref| (pulses/s)")
+    ax.set_title("accuracy against cost (labels: dt in ms)")
+    ax.legend(fontsize=7, ncol=2)
     return fig

@@ -29,26 +29,41 @@ from __future__ import annotations
 
 import gc
 import hashlib
+import logging
 import os
 import sys
 import threading
+import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["run_brian2", "cache_dir"]
+from .neuron import V_FLOOR
+
+__all__ = ["run_brian2", "cache_dir", "Brian2Warning"]
 
 _COMPILE_ARGS = ["-w", "-O3", "-ffp-contract=off", "-march=native", "-std=c++11"]
-_TEMPLATE_VERSION = "1"  # bump when the generated network changes
+_TEMPLATE_VERSION = "2"  # bump when the generated network changes
 _NEURON_QUANTUM = 32  # neuron padding granularity
 _SAMPLE_QUANTUM = 250  # sample padding granularity
 _MAX_ELEMENTS = 1 << 25  # TimedArray elements per run: 256 MB, far below 2**31
 
-_EQUATIONS = """
+_ODE = """
 dv/dt = (0.04*v**2 + 5*v + 140 - u + I_in)/ms : 1
 du/dt = a*(b*v - u)/ms : 1
+"""
+# Izhikevich (2003) is not a Brian2 state updater: v and u are plain variables
+# updated by explicit code, two half-steps of v, then u from the new v.
+_STATE = """
+v : 1
+u : 1
+"""
+_IZHIKEVICH_2003 = """v = v + 0.5*(dt/ms)*(0.04*v**2 + 5*v + 140 - u + I_in)
+v = v + 0.5*(dt/ms)*(0.04*v**2 + 5*v + 140 - u + I_in)
+u = u + (dt/ms)*(a*(b*v - u))"""
+_VARIABLES = """
 I_in : 1
 v_end : 1
 u_end : 1
@@ -94,18 +109,48 @@ def _pad(n: int, quantum: int) -> int:
 def _key_dir(key: tuple) -> Path:
     brian2 = _import_brian2()
 
-    text = repr((key, brian2.__version__, _COMPILE_ARGS, _TEMPLATE_VERSION, _EQUATIONS))
+    text = repr((key, brian2.__version__, _COMPILE_ARGS, _TEMPLATE_VERSION, _ODE, _VARIABLES, _IZHIKEVICH_2003))
     digest = hashlib.sha256(text.encode()).hexdigest()[:16]
     n_neurons, n_samples, substeps, dt, method = key
     return cache_dir() / f"n{n_neurons}_t{n_samples}_s{substeps}_{method}_{digest}"
 
 
+class Brian2Warning(RuntimeWarning):
+    """A warning Brian2 logged while building or running the engine."""
+
+
+class _LogToWarnings(logging.Handler):
+    """Re-issue Brian2's logged warnings as Python warnings (filterable, testable)."""
+
+    def emit(self, record):
+        warnings.warn(Brian2Warning(f"Brian2 ({record.name}): {record.getMessage()}"), stacklevel=2)
+
+
+_QUIETED = False
+
+
 def _import_brian2():
-    """Import Brian2 quietly: no banner or script copies on unrelated exceptions."""
+    """Import Brian2 without letting it take over the process's warnings and logging.
+
+    On import Brian2 calls ``logging.captureWarnings(True)``, which reroutes
+    every Python warning of the process into its log (a user's
+    ``catch_warnings`` and our own `SpikeCapWarning` would vanish); that is
+    undone here.  Brian2's own warnings become `Brian2Warning`s instead of
+    console lines, and its error banner and script copies are switched off.
+    """
+    global _QUIETED
     import brian2
 
-    brian2.prefs["logging.display_brian_error_message"] = False
-    brian2.prefs["logging.save_script"] = False
+    if not _QUIETED:
+        from brian2.utils.logger import BrianLogger
+
+        logging.captureWarnings(False)
+        brian2.prefs["logging.display_brian_error_message"] = False
+        brian2.prefs["logging.save_script"] = False
+        if BrianLogger.console_handler is not None:
+            BrianLogger.console_handler.setLevel(logging.ERROR)
+        logging.getLogger("brian2").addHandler(_LogToWarnings(level=logging.WARNING))
+        _QUIETED = True
     return brian2
 
 
@@ -151,10 +196,14 @@ def _build(key: tuple) -> _Build:
         b2.set_device(standalone, directory=str(directory), build_on_run=False)
         fs = 1.0 / (dt * substeps)
         ta = b2.TimedArray(np.zeros((n_samples, n_neurons)), dt=(1.0 / fs) * b2.second, name="ddmm_current")
+        explicit = method == "izhikevich2003"
         group = b2.NeuronGroup(
-            n_neurons, _EQUATIONS, threshold="v >= 30", reset="v = c; u += d",
-            method=method, dt=dt * b2.second, name="afferents", namespace={"ms": b2.ms},
+            n_neurons, (_STATE if explicit else _ODE) + _VARIABLES, threshold="v >= 30", reset="v = c; u += d",
+            method=None if explicit else method, dt=dt * b2.second, name="afferents", namespace={"ms": b2.ms},
         )
+        if explicit:
+            group.run_regularly(_IZHIKEVICH_2003, when="groups", name="afferents_izhikevich2003")
+        group.run_regularly(f"v = clip(v, {V_FLOOR!r}, inf)", when="before_thresholds", name="afferents_floor")
         # Hold the current for one sample; when t reaches t_end (the end of the
         # real input) copy the state, which later padded steps then overwrite.
         code = (
@@ -214,14 +263,14 @@ def _run_chunk(build: _Build, current, params, v, u):
     return neuron[keep], step[keep], v_final, u_final
 
 
-def run_brian2(current, substeps, dt, params, v, u, method="euler", v_peak=30.0):
+def run_brian2(current, substeps, dt, params, v, u, method="euler", v_peak=30.0, v_floor=V_FLOOR):
     """Integrate eqs 4-6 for N neurons with Brian2 (same contract as `run_direct`).
 
     ``v`` and ``u`` are updated in place to the final state.  Returns
     ``(neuron, step)`` int64 arrays sorted by step then neuron.
     """
-    if v_peak != 30.0:
-        raise ValueError(f"v_peak={v_peak!r}: the Brian2 engine is built for the paper's 30 mV")
+    if v_peak != 30.0 or v_floor != V_FLOOR:
+        raise ValueError(f"the Brian2 engine is built for v_peak = 30 and v_floor = {V_FLOOR} mV")
     with _LOCK:
         return _run_locked(current, substeps, dt, params, v, u, method)
 

@@ -2,15 +2,20 @@
 
 Each step follows the schedule of DDMM-NOTES §3 exactly as Brian2 runs it:
 
-1. u and v are both updated from the old (v, u) (forward Euler);
-2. threshold ``v >= 30`` on the new v;
-3. reset ``v = c; u = u + d`` and the spike is recorded at the step index.
+1. the state is updated (forward Euler, Brian2's "rk2" midpoint and "rk4",
+   or Izhikevich's 2003 scheme: two half-steps of v, then u from the new v);
+2. v is floored at ``V_FLOOR`` (-100 mV; a no-op for physiological input,
+   it stops strongly negative currents from driving Euler into false
+   spiking at large dt);
+3. threshold ``v >= 30`` on the new v;
+4. reset ``v = c; u = u + d`` and the spike is recorded at the step index.
 
 The arithmetic is written in the same association order as the C++ that
 Brian2 2.9 generates for `models.brian2_engine`'s equations (sympy's
-canonical order), and both are compiled without fast-math or FMA
+canonical order, e.g. its rk updaters expand ``5 (v + k/2)`` into
+``2.5 k + 5 v``), and both are compiled without fast-math or FMA
 contraction, so the two engines give identical spikes, not merely close
-ones.  ``tests/models/test_engines.py`` holds them to it.
+ones.  ``tests/models/test_engines.py`` holds them to it for every method.
 
 Neurons are processed in blocks with time as the outer loop, so the inner
 loop over a block vectorises; blocks are shared between threads (numba
@@ -28,7 +33,7 @@ import numpy as np
 __all__ = ["run_direct", "default_threads"]
 
 _BLOCK = 64  # neurons advanced together; 64 doubles of v and u stay in L1
-_METHOD_CODES = {"euler": 0}
+_METHOD_CODES = {"euler": 0, "rk2": 1, "rk4": 2, "izhikevich2003": 3}
 
 
 def default_threads() -> int:
@@ -45,10 +50,72 @@ def default_threads() -> int:
     return max(1, os.cpu_count() or 1)
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def _dv(v, u, i):
+    """dv/dt without dt, in Brian2's association: 140 + ((I + 0.04 v^2) + 5 v) - u."""
+    return (140.0 + ((i + (0.04 * (v * v))) + (5.0 * v))) - u
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _dv_shifted(v, u, i, kv, ku, f):
+    """dv/dt at (v + f kv, u + f ku) as Brian2's rk code expands it (f = 0.5 or 1)."""
+    w = (f * kv) + v if f != 1.0 else kv + v
+    shifted_u = (f * ku) + u if f != 1.0 else ku + u
+    return (140.0 + (((i + ((5.0 * f) * kv)) + (5.0 * v)) + (0.04 * (w * w)))) - shifted_u
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _du_shifted(v, u, a, b, kv, ku, f):
+    """du/dt at (v + f kv, u + f ku) as Brian2's rk code expands it (f = 0.5 or 1)."""
+    if f != 1.0:
+        return a * (((f * (-ku)) + (b * ((f * kv) + v))) - u)
+    return a * (((-ku) + (b * (kv + v))) - u)
+
+
 @nb.njit(cache=True, nogil=True)
-def _euler_block(current, substeps, dt_ms, a, b, c, d, v, u, v_peak, j0, k_start, idx, stp, n):
+def _update(method, h, half, row, a, b, v, u):
+    """One step of the chosen scheme for every neuron of a block (Brian2's arithmetic)."""
+    m = v.size
+    if method == 0:  # forward Euler
+        for j in range(m):
+            vj, uj = v[j], u[j]
+            u[j] = (h * (a[j] * ((b[j] * vj) - uj))) + uj
+            v[j] = (h * _dv(vj, uj, row[j])) + vj
+    elif method == 1:  # midpoint (Brian2 "rk2")
+        for j in range(m):
+            vj, uj, i = v[j], u[j], row[j]
+            ku = h * (a[j] * ((b[j] * vj) - uj))
+            kv = h * _dv(vj, uj, i)
+            u[j] = (h * _du_shifted(vj, uj, a[j], b[j], kv, ku, 0.5)) + uj
+            v[j] = (h * _dv_shifted(vj, uj, i, kv, ku, 0.5)) + vj
+    elif method == 2:  # classical Runge-Kutta (Brian2 "rk4")
+        for j in range(m):
+            vj, uj, i, aj, bj = v[j], u[j], row[j], a[j], b[j]
+            k1u = h * (aj * ((bj * vj) - uj))
+            k1v = h * _dv(vj, uj, i)
+            k2u = h * _du_shifted(vj, uj, aj, bj, k1v, k1u, 0.5)
+            k2v = h * _dv_shifted(vj, uj, i, k1v, k1u, 0.5)
+            k3u = h * _du_shifted(vj, uj, aj, bj, k2v, k2u, 0.5)
+            k3v = h * _dv_shifted(vj, uj, i, k2v, k2u, 0.5)
+            k4u = h * _du_shifted(vj, uj, aj, bj, k3v, k3u, 1.0)
+            k4v = h * _dv_shifted(vj, uj, i, k3v, k3u, 1.0)
+            sixth, third = 0.16666666666666666, 0.3333333333333333
+            u[j] = ((((sixth * k1u) + (third * k2u)) + (third * k3u)) + (sixth * k4u)) + uj
+            v[j] = ((((sixth * k1v) + (third * k2v)) + (third * k3v)) + (sixth * k4v)) + vj
+    else:  # Izhikevich (2003): two half-steps of v, then u from the new v
+        for j in range(m):
+            vj, uj, i = v[j], u[j], row[j]
+            vj = vj + half * _dv(vj, uj, i)
+            vj = vj + half * _dv(vj, uj, i)
+            v[j] = vj
+            u[j] = uj + h * (a[j] * ((b[j] * vj) - uj))
+
+
+@nb.njit(cache=True, nogil=True)
+def _block(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, j0, k_start, idx, stp, n):
     """Advance one block (local arrays a..u, columns j0.. of ``current``) from sample k_start.
 
+    Each step: update (``method``), floor v at ``v_floor``, threshold, reset.
     Spikes go to the fixed buffers ``idx``/``stp`` from position ``n``.  The
     buffers are never reallocated here (that would stop the update loop from
     vectorising); when one more sample could overflow them, the kernel
@@ -63,13 +130,10 @@ def _euler_block(current, substeps, dt_ms, a, b, c, d, v, u, v_peak, j0, k_start
         row = current[k, j0 : j0 + m]
         for s in range(substeps):
             step = k * substeps + s
+            _update(method, h, half, row, a, b, v, u)
             for j in range(m):
-                vj = v[j]
-                uj = u[j]
-                # Same association as Brian2's generated code (see module doc).
-                u[j] = (dt_ms * (a[j] * ((b[j] * vj) - uj))) + uj
-                v[j] = (dt_ms * ((140.0 + ((row[j] + (0.04 * (vj * vj))) + (5.0 * vj))) - uj)) + vj
-            for j in range(m):
+                if v[j] < v_floor:
+                    v[j] = v_floor
                 if v[j] >= v_peak:
                     v[j] = c[j]
                     u[j] = u[j] + d[j]
@@ -87,7 +151,7 @@ def _double(buf, n):
 
 
 @nb.njit(cache=True, nogil=True)
-def _integrate_range(current, substeps, dt_ms, a, b, c, d, v, u, v_peak, block, lo, hi):
+def _integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, lo, hi):
     """Integrate neurons lo..hi (columns of the C-contiguous ``current``); return spikes."""
     capacity = max(4096, 4 * block * substeps)
     idx, stp, n = np.empty(capacity, np.int64), np.empty(capacity, np.int64), 0
@@ -98,7 +162,8 @@ def _integrate_range(current, substeps, dt_ms, a, b, c, d, v, u, v_peak, block, 
         vb, ub = v[j0:j1].copy(), u[j0:j1].copy()
         k = 0
         while k < current.shape[0]:
-            k, n = _euler_block(current, substeps, dt_ms, ab, bb, cb, db, vb, ub, v_peak, j0, k, idx, stp, n)
+            k, n = _block(current, substeps, method, h, half, ab, bb, cb, db, vb, ub, v_peak, v_floor, j0, k,
+                          idx, stp, n)
             if k < current.shape[0]:  # buffers nearly full: double them and resume
                 idx, stp = _double(idx, n), _double(stp, n)
         v[j0:j1] = vb
@@ -116,7 +181,7 @@ def _executor(threads: int) -> ThreadPoolExecutor:
     return _EXECUTOR
 
 
-def run_direct(current, substeps, dt, params, v, u, method="euler", v_peak=30.0, threads=None):
+def run_direct(current, substeps, dt, params, v, u, method="euler", v_peak=30.0, v_floor=-100.0, threads=None):
     """Integrate eqs 4-6 for N neurons with the direct engine.
 
     Parameters
@@ -131,10 +196,12 @@ def run_direct(current, substeps, dt, params, v, u, method="euler", v_peak=30.0,
         Per-neuron ``a``, ``b``, ``c``, ``d`` (see `models.neuron`).
     v, u : ndarray, shape (n_neurons,)
         Initial state in mV and mV/ms; updated in place to the final state.
-    method : str
-        Integration scheme (``"euler"``).
+    method : {"euler", "rk2", "rk4", "izhikevich2003"}
+        Integration scheme.
     v_peak : float
         Spike cut-off in mV.
+    v_floor : float
+        Lower bound on v in mV, applied after every step.
     threads : int, optional
         Worker threads; default `default_threads`.
 
@@ -145,7 +212,8 @@ def run_direct(current, substeps, dt, params, v, u, method="euler", v_peak=30.0,
     """
     if method not in _METHOD_CODES:  # validated at the seam; guard the kernel
         raise ValueError(f"method={method!r} is not implemented by the direct engine")
-    dt_ms = 1.0 * dt / 0.001  # Brian2 computes dt/ms the same way
+    h = 1.0 * dt / 0.001  # Brian2 computes dt/ms the same way
+    half = (1.0 * (0.5 * dt)) / 0.001  # and the Izhikevich half-step as (0.5 dt)/ms
     n_neurons = current.shape[1]
     threads = default_threads() if threads is None else threads
     bounds = np.linspace(0, n_neurons, min(threads, max(1, n_neurons // _BLOCK)) + 1).astype(int)
@@ -157,7 +225,8 @@ def run_direct(current, substeps, dt, params, v, u, method="euler", v_peak=30.0,
     # The whole C-contiguous array goes to every thread (a column slice would
     # be strided and defeat vectorisation); each thread owns a column range.
     def work(lo, hi):
-        return _integrate_range(current, substeps, dt_ms, *args, v, u, v_peak, _BLOCK, int(lo), int(hi))
+        return _integrate_range(current, substeps, _METHOD_CODES[method], h, half, *args, v, u, v_peak, v_floor,
+                                _BLOCK, int(lo), int(hi))
 
     ranges = list(zip(bounds[:-1], bounds[1:]))
     if len(ranges) == 1:

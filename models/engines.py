@@ -9,17 +9,33 @@ whatever the step, so changing dt changes only the integration error.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from ._validation import as_finite_array, check_choice, check_positive
-from .neuron import V_PEAK, NeuronParams, neuron_arrays, resting_state
+from .neuron import V_FLOOR, V_PEAK, NeuronParams, neuron_arrays, resting_state
 
-__all__ = ["ENGINES", "METHODS", "NeuronState", "SpikeResult", "substeps_for", "prepare", "integrate"]
+__all__ = ["ENGINES", "METHODS", "MAX_NEGATIVE_DRIVE_MV", "NeuronState", "SpikeResult", "NumericalInstabilityError", "SpikeCapWarning",
+           "substeps_for", "prepare", "integrate"]
 
 ENGINES = ("brian2", "direct")
-METHODS = ("euler",)
+#: Largest negative drive per step, dt * (-I) in mV, that the multi-stage methods
+#: accept.  Beyond it their intermediate stages overshoot far below -100 mV,
+#: where dv/dt = 0.04 v^2 + ... turns large and positive: rk2 then fires false
+#: spikes every step and rk4 and the 2003 scheme overflow.  Euler needs no such
+#: limit: the v floor protects it.
+MAX_NEGATIVE_DRIVE_MV = 50.0
+METHODS = ("euler", "rk2", "rk4", "izhikevich2003")
+
+
+class NumericalInstabilityError(ValueError):
+    """The integration left the finite numbers (the method is unstable at this dt and current)."""
+
+
+class SpikeCapWarning(RuntimeWarning):
+    """A neuron spiked on consecutive steps: the one-spike-per-step cap bound, rates are limited by 1/dt."""
 
 
 @dataclass(frozen=True)
@@ -138,8 +154,10 @@ def integrate(
         ``"SAI"``, ``"RAI"`` or ``"RAII"``, one per column or one for all.
     engine : {"brian2", "direct"}
         Brian2 C++ standalone (default) or the numba integrator.  Same spikes.
-    method : {"euler"}
-        Integration scheme.
+    method : {"euler", "rk2", "rk4", "izhikevich2003"}
+        Integration scheme: forward Euler (default), Brian2's midpoint
+        "rk2" and classical "rk4", or Izhikevich's 2003 scheme (two
+        half-steps of v, then u from the new v).
     state : NeuronState, optional
         Initial state; default: each neuron's resting fixed point.
     neuron_params : dict, optional
@@ -148,6 +166,17 @@ def integrate(
     Returns
     -------
     SpikeResult
+
+    Raises
+    ------
+    NumericalInstabilityError
+        If the state becomes non-finite (rk4 and the 2003 scheme can, at
+        large dt and current); NaN never leaves this function.
+
+    Warns
+    -----
+    SpikeCapWarning
+        When a neuron spikes on consecutive steps.
 
     Examples
     --------
@@ -165,14 +194,47 @@ def integrate(
     params = neuron_arrays(types, neuron_params)
     v, u = _initial_state(state, params["b"], n)
     current = np.ascontiguousarray(current)
+    _check_stability(current, dt, method)
     if n == 0 or current.shape[0] == 0:
         neuron = step = np.empty(0, np.int64)
     elif engine == "direct":
         from .direct import run_direct
 
-        neuron, step = run_direct(current, substeps, dt, params, v, u, method=method, v_peak=V_PEAK)
+        neuron, step = run_direct(current, substeps, dt, params, v, u, method=method, v_peak=V_PEAK, v_floor=V_FLOOR)
     else:
         from .brian2_engine import run_brian2
 
-        neuron, step = run_brian2(current, substeps, dt, params, v, u, method=method, v_peak=V_PEAK)
+        neuron, step = run_brian2(current, substeps, dt, params, v, u, method=method, v_peak=V_PEAK, v_floor=V_FLOOR)
+    _check(neuron, step, v, u, current, method, dt)
     return SpikeResult(neuron, step, NeuronState(v, u), dt, current.shape[0] * substeps)
+
+
+def _check_stability(current, dt, method) -> None:
+    """Refuse negative drives a multi-stage method cannot integrate (see MAX_NEGATIVE_DRIVE_MV)."""
+    if method == "euler" or current.size == 0:
+        return
+    drive = -float(current.min()) * dt * 1e3
+    if drive > MAX_NEGATIVE_DRIVE_MV:
+        raise NumericalInstabilityError(
+            f"method={method!r} is unstable for currents down to {current.min():.3g} mV/ms at dt={dt * 1e3:g} ms "
+            f"(a step's negative drive of {drive:.3g} mV exceeds {MAX_NEGATIVE_DRIVE_MV:g} mV); "
+            "use method='euler' (protected by the v floor) or a smaller dt"
+        )
+
+
+def _check(neuron, step, v, u, current, method, dt) -> None:
+    """Never hand back NaN; warn when the one-spike-per-step cap bound."""
+    if not (np.all(np.isfinite(v)) and np.all(np.isfinite(u))):
+        bad = int(np.flatnonzero(~(np.isfinite(v) & np.isfinite(u)))[0])
+        raise NumericalInstabilityError(
+            f"method={method!r} diverged (non-finite membrane state, neuron {bad}) at dt={dt * 1e3:g} ms with "
+            f"currents up to {np.abs(current).max():.3g} mV/ms; use a smaller dt or method='euler'"
+        )
+    if neuron.size > 1:
+        order = np.lexsort((step, neuron))
+        consecutive = (np.diff(step[order]) == 1) & (np.diff(neuron[order]) == 0)
+        if consecutive.any():
+            n_capped = np.unique(neuron[order][1:][consecutive]).size
+            warnings.warn(SpikeCapWarning(
+                f"{n_capped} neuron(s) spiked on consecutive steps: the one-spike-per-step cap bound at "
+                f"dt={dt * 1e3:g} ms (rates up to {1.0 / dt:.0f} pulses/s); use a smaller dt"), stacklevel=3)

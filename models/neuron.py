@@ -22,6 +22,7 @@ from .currents import AFFERENT_TYPES
 
 __all__ = [
     "V_PEAK",
+    "V_FLOOR",
     "NeuronParams",
     "NEURON_PARAMS",
     "resting_state",
@@ -30,6 +31,11 @@ __all__ = [
 
 #: Spike cut-off in mV (eq. 6).
 V_PEAK = 30.0
+#: Lower bound on v in mV, applied after every step.  The model never gets
+#: there with the package's currents (rest is -70 or -64.4 mV); it stops a
+#: strongly negative user current from driving forward Euler into a false
+#: oscillation (dt > 2/sqrt(0.64 - 0.16 I) ms for B = 0.2) and 1/(2 dt) spiking.
+V_FLOOR = -100.0
 
 
 @dataclass(frozen=True)

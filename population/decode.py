@@ -33,7 +33,8 @@ from scipy.optimize import minimize
 
 from models.metrics import CONTACT_THRESHOLD
 
-__all__ = ["angular_error", "contact_onset", "window_responses", "select_afferents", "PopulationVector",
+__all__ = ["angular_error", "contact_onset", "window_responses", "select_afferents", "population_vector",
+           "PopulationVector",
            "MaximumLikelihood", "FirstSpikeLatency", "DECODERS"]
 
 _GRID = np.deg2rad(np.arange(0.0, 360.0, 0.5))
@@ -160,26 +161,35 @@ class _Decoder:
                             attrs={"units": "deg", "decoder": self.name, "window_s": self.window_s})
 
 
+def population_vector(responses, theta_t_deg, nap, baseline, scale) -> np.ndarray:
+    """Population-vector direction (radians) of each row of ``responses`` (obs, afferent).
+
+    Weights ``(r - baseline) / scale`` multiply unit vectors at theta_T for
+    unipolar afferents; bipolar afferents vote on the doubled-angle circle and
+    that axis is folded onto the unipolar estimate; untuned ones are ignored.
+    """
+    theta = np.deg2rad(np.asarray(theta_t_deg, float))
+    nap = np.asarray(nap, dtype=object)
+    w = (np.asarray(responses, float) - baseline) / scale
+    uni = w @ (np.exp(1j * theta) * np.isin(nap, ("selective", "broad")))
+    axial = w @ (np.exp(2j * theta) * (nap == "bipolar"))
+    half = np.angle(axial) / 2.0  # axis, 180-deg ambiguous
+    pick = np.where(np.cos(half - np.angle(uni)) >= 0, half, half + np.pi)
+    return np.angle(uni + np.abs(axial) * np.exp(1j * pick))
+
+
 class PopulationVector(_Decoder):
-    """Rate-weighted unit vectors at theta_T; bipolar afferents axial (see module doc)."""
+    """Rate-weighted unit vectors at theta_T; bipolar afferents axial (see `population_vector`)."""
 
     name = "population_vector"
 
     def _fit(self, ds, counts, latency, angles):
         self.baseline_ = counts.mean(axis=0)
         self.scale_ = counts.std(axis=0) + 1.0  # equalises afferents with different rates
-        theta = np.deg2rad(ds.theta_t.values)
-        nap = ds.nap.values
-        self.unipolar_ = np.exp(1j * theta) * np.isin(nap, ("selective", "broad"))
-        self.axial_ = np.exp(2j * theta) * (nap == "bipolar")
+        self.theta_t_, self.nap_ = ds.theta_t.values, ds.nap.values
 
     def _predict(self, counts, latency):
-        w = (counts - self.baseline_) / self.scale_
-        uni = w @ self.unipolar_
-        axial = w @ self.axial_
-        half = np.angle(axial) / 2.0  # axis, 180-deg ambiguous
-        pick = np.where(np.cos(half - np.angle(uni)) >= 0, half, half + np.pi)
-        return np.angle(uni + np.abs(axial) * np.exp(1j * pick))
+        return population_vector(counts, self.theta_t_, self.nap_, self.baseline_, self.scale_)
 
 
 class MaximumLikelihood(_Decoder):

@@ -27,7 +27,7 @@ from .plan import RECORD_CHOICES, make_plan
 from .sampling import Population
 from .scenes import Scene
 
-__all__ = ["SimConfig", "ChunkJob", "run_chunk", "simulate", "plan_run"]
+__all__ = ["SimConfig", "ChunkJob", "run_chunk", "simulate", "plan_run", "population_currents"]
 
 _PIPELINE = 2  # afferent blocks in flight at once
 
@@ -148,6 +148,28 @@ def _run_trial(job: ChunkJob, trial: int, config: SimConfig, progress=None):
     return np.concatenate(afferents), np.concatenate(steps)
 
 
+def population_currents(population, scene, *, no_shear: str = "pass") -> np.ndarray:
+    """Noise-free input currents (mV/ms) of every afferent, shape (n_samples, n_afferents).
+
+    The same computation `simulate` runs (AF, receptive fields, gains, filter),
+    for inspection and for the reference solver; noise is not added.
+    """
+    check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
+    weights = None
+    if scene.contact is not None:
+        from .spatial import receptive_field_weight
+
+        weights = receptive_field_weight(population.x_mm, population.y_mm, population.afferent_type, scene.contact)
+    scale = population.gain if weights is None else population.gain * weights
+    order = _grouped(population, np.arange(len(population)), np.arange(len(population)))
+    job = ChunkJob(scene, population.select(order), 0, (0,), False, True, 1.0 if no_shear == "pass" else 0.0,
+                   None if weights is None else weights[order])
+    current = _currents(job, _attenuated(job, slice(None), no_shear), {}, scale[order])
+    out = np.empty_like(current)
+    out[:, order] = current
+    return out
+
+
 def run_chunk(job: ChunkJob, config: SimConfig, progress=None):
     """Simulate one block; returns (trial, afferent index within the block, step) arrays."""
     trials, afferents, steps = [], [], []
@@ -244,7 +266,7 @@ def _expand(cond, members, the_plan, block, deterministic, result):
             np.tile(step[source], n_trials))
 
 
-def simulate(population, scenes, *, engine="brian2", dt=1e-4, method="euler", trials=1, seed=None,
+def simulate(population, scenes, *, engine="brian2", dt=None, method=None, tolerance=None, trials=1, seed=None,
              record=RECORD_CHOICES, no_shear="pass", types=None, plan=True, chunk_size=4096,
              time_chunk=2000, quiet=False):
     """Simulate a population on one or more scenes.
@@ -257,10 +279,14 @@ def simulate(population, scenes, *, engine="brian2", dt=1e-4, method="euler", tr
         One condition per scene; all share one sample rate.
     engine : {"brian2", "direct"}
         Simulation engine; both give identical spikes.
-    dt : float
+    dt : float, optional
         Integration step in seconds (default 0.1 ms).
-    method : str
-        Integration scheme.
+    method : str, optional
+        Integration scheme (default ``"euler"``).
+    tolerance : float, optional
+        Instead of ``dt`` and ``method``: the largest acceptable mean SF
+        error in pulses/s; the cheapest measured (dt, method) within it is
+        used (`population.accuracy.choose_setting`) and stated in the attrs.
     trials : int
         Trials per condition (noise differs between trials).
     seed : int, numpy Generator or None
@@ -295,6 +321,8 @@ def simulate(population, scenes, *, engine="brian2", dt=1e-4, method="euler", tr
 
     from .dataset import build_dataset
 
+    scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
+    dt, method, choice = _resolve_step(dt, method, tolerance, scenes)
     scenes = _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_size, time_chunk)
     config = SimConfig(engine, float(dt), method, no_shear, root_seed(seed), int(time_chunk))
     the_plan = plan_run(population, scenes, trials=trials, record=record, no_shear=no_shear, types=types,
@@ -312,4 +340,23 @@ def simulate(population, scenes, *, engine="brian2", dt=1e-4, method="euler", tr
                    for c, job, block, det in _jobs(population, scenes, the_plan)]
         for c, block, det, future in running:
             spikes[c].append(_expand(the_plan.conditions[c], members[c], the_plan, block, det, future.result()))
-    return build_dataset(population, scenes, the_plan, spikes, config)
+    ds = build_dataset(population, scenes, the_plan, spikes, config)
+    ds.attrs.update(choice)
+    return ds
+
+
+def _resolve_step(dt, method, tolerance, scenes):
+    """(dt, method, attrs) from explicit values, a tolerance, or the defaults."""
+    if tolerance is None:
+        return (1e-4 if dt is None else dt), ("euler" if method is None else method), {"tolerance": "none"}
+    if dt is not None or method is not None:
+        raise ValueError("give tolerance or dt/method, not both: tolerance chooses dt and method")
+    if not scenes or not isinstance(scenes[0], Scene):
+        raise TypeError("scenes must be a Scene or a non-empty sequence of Scenes")
+    from .accuracy import choose_setting
+
+    row = choose_setting(tolerance, scenes[0].fs)
+    attrs = {"tolerance": float(tolerance),
+             "tolerance_choice": f"dt={row['dt_ms']:g} ms, method={row['method']}: cheapest measured setting with "
+                                 f"mean SF error {row['sf_err_mean']:.3g} <= {tolerance:g} pulses/s"}
+    return row["dt_ms"] * 1e-3, row["method"], attrs

@@ -6,7 +6,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from models.engines import NeuronState, integrate, substeps_for
+import warnings
+
+from models.engines import NeuronState, SpikeCapWarning, integrate, substeps_for
 from models.pipeline import simulate
 from tests.conftest import ENGINES
 
@@ -19,11 +21,13 @@ def spikes(res):
 
 @given(current=hnp.arrays(np.float64, st.tuples(st.integers(1, 200), st.integers(1, 30)),
                           elements=st.floats(-20.0, 250.0, allow_subnormal=False)),
-       seed=st.integers(0, 2**16))
-def test_engines_identical_on_random_currents(current, seed):
+       seed=st.integers(0, 2**16), method=st.sampled_from(["euler", "rk2", "rk4", "izhikevich2003"]))
+def test_engines_identical_on_random_currents(current, seed, method):
     types = np.random.default_rng(seed).choice(TYPES, current.shape[1])
-    a = integrate(current, fs=1000.0, dt=1e-4, afferent_type=types, engine="direct")
-    b = integrate(current, fs=1000.0, dt=1e-4, afferent_type=types, engine="brian2")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SpikeCapWarning)
+        a = integrate(current, fs=1000.0, dt=1e-4, afferent_type=types, engine="direct", method=method)
+        b = integrate(current, fs=1000.0, dt=1e-4, afferent_type=types, engine="brian2", method=method)
     assert spikes(a) == spikes(b)
     np.testing.assert_array_equal(a.state.v, b.state.v)
     np.testing.assert_array_equal(a.state.u, b.state.u)
@@ -81,6 +85,7 @@ def test_substeps_must_be_whole():
     (dict(dt=0.0), ValueError, "dt"),
     (dict(engine="neuron"), ValueError, "engine"),
     (dict(method="rk9"), ValueError, "method"),
+    (dict(method="rk45"), ValueError, "method"),
     (dict(afferent_type="SAII"), ValueError, "afferent_type"),
     (dict(state=(1, 2)), TypeError, "state"),
     (dict(state=NeuronState(np.zeros(2), np.zeros(2))), ValueError, "state"),
