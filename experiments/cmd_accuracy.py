@@ -43,17 +43,16 @@ def _split(text, cast=str):
 
 
 def run(args) -> int:
+    from models._validation import check_choice
     from models.engines import ENGINES, METHODS
 
     from .accuracy import DTS_MS, run_accuracy, tolerance_table
 
     engines, methods = _split(args.engines), _split(args.methods) or METHODS
     for e in engines:
-        if e not in ENGINES:
-            raise ValueError(f"--engines: {e!r} is unknown; allowed: {', '.join(ENGINES)}")
+        check_choice(e, "--engines", ENGINES)
     for m in methods:
-        if m not in METHODS:
-            raise ValueError(f"--methods: {m!r} is unknown; allowed: {', '.join(METHODS)}")
+        check_choice(m, "--methods", METHODS)
     out_dir = ensure_out_dir(args.out) if args.out else None
     result = run_accuracy(_split(args.dts, float) or DTS_MS, methods, engines)
     shaped = {"rows": [{k: r[k] for k in ("dt_ms", "method", "engine", "wall_s_per_afferent_s", "sf_err_mean",

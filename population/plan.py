@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from models._validation import check_choice
 from models.attenuation import F_TH, UNTUNED
 from models.currents import AFFERENT_TYPES
 
@@ -216,11 +217,9 @@ def make_plan(population, scenes, *, types=None, trials: int = 1, record=RECORD_
     """
     requested = tuple(AFFERENT_TYPES) if types is None else tuple(types)
     for t in requested:
-        if t not in AFFERENT_TYPES:
-            raise ValueError(f"types: {t!r} is unknown; allowed: {', '.join(AFFERENT_TYPES)}")
+        check_choice(t, "types", AFFERENT_TYPES)
     for r in record:
-        if r not in RECORD_CHOICES:
-            raise ValueError(f"record: {r!r} is unknown; allowed: {', '.join(RECORD_CHOICES)}")
+        check_choice(r, "record", RECORD_CHOICES)
     wanted = np.isin(population.afferent_type, requested)
     selected = np.arange(len(population)) if not enabled else np.flatnonzero(wanted)
     keep = np.flatnonzero(wanted[selected])
