@@ -25,7 +25,7 @@ import time
 
 from .reference import TOUCHSIM_SPEED
 
-__all__ = ["CASES", "run_case", "run_bench", "register"]
+__all__ = ["CASES", "EXTRA_CASES", "run_case", "run_extra", "run_bench", "register"]
 
 #: name -> (population, engine, simulated seconds, warm-up?)
 CASES = {
@@ -35,6 +35,9 @@ CASES = {
     "hand_1s_brian2": ("hand", "brian2", 1.0, True),
     "hand_10s_direct": ("hand", "direct", 10.0, False),
 }
+#: Cases beyond one process: 100,000 afferents in-process and on 2 local Dask
+#: workers, and the streaming encoder's per-chunk latency.
+EXTRA_CASES = ("scale_100k_inprocess", "scale_100k_2workers", "stream_fingertip", "stream_hand")
 DT = 1e-4
 
 
@@ -59,6 +62,91 @@ def run_case(name: str) -> dict:
             "wall_s": round(wall, 4), "afferent_s_per_wall_s": round(n * sim_s / wall, 1),
             "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
             "spikes": int(ds.sizes["spike"])}
+
+
+def _population_100k():
+    """The hand preset with every count x 8: 100,152 afferents."""
+    import dataclasses
+
+    from population import load_spec, sample_population
+
+    spec = load_spec("hand")
+    spec = spec.replace(types={k: dataclasses.replace(t, count=t.count * 8) for k, t in spec.types.items()})
+    return sample_population(spec, rng=0)
+
+
+def _scale_case(workers: int) -> dict:
+    """100k afferents x 1 s: in this process (workers=0) or on a local Dask cluster."""
+    from population import birznieks, simulate
+
+    pop, scene = _population_100k(), birznieks(90.0, hold_s=0.75)
+    result = {"name": "scale_100k_inprocess" if workers == 0 else f"scale_100k_{workers}workers",
+              "engine": "direct", "n_afferents": len(pop), "sim_s": 1.0, "dt_ms": DT * 1e3, "workers": workers}
+    if workers == 0:
+        simulate(pop.select(range(2000)), scene, engine="direct", seed=0, quiet=True)  # warm-up
+        start = time.perf_counter()
+        simulate(pop, scene, engine="direct", seed=0, quiet=True)
+        wall = time.perf_counter() - start
+        result["peak_rss_mb"] = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1)
+    else:
+        from distributed import Client, LocalCluster
+
+        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
+                Client(cl) as client:
+            simulate(pop.select(range(2000)), scene, engine="direct", seed=0, quiet=True, scheduler=client)
+            start = time.perf_counter()
+            simulate(pop, scene, engine="direct", seed=0, quiet=True, scheduler=client)
+            wall = time.perf_counter() - start
+            rss = client.run(lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
+        result["peak_rss_per_worker_mb"] = round(max(rss.values()), 1)
+        result["peak_rss_mb"] = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1)
+    result.update(wall_s=round(wall, 3), afferent_s_per_wall_s=round(len(pop) / wall, 1))
+    return result
+
+
+def _stream_case(population: str, seconds: float = 3.0) -> dict:
+    """Per-chunk processing time of the streaming encoder, 1 ms chunks at fs = 1 kHz, paced in real time.
+
+    Chunks arrive every millisecond, as from a sensor; each push's processing
+    time is measured.  (A loop pushing as fast as it can would measure
+    throughput, not latency, and starve the encoder's noise prefetch.)
+    """
+    import numpy as np
+
+    from population import birznieks, sample_population
+    from population.stream import Encoder
+
+    pop = sample_population(population, rng=0)
+    scene = birznieks(90.0, hold_s=seconds - 0.25)
+    forces = np.column_stack([scene.fx, scene.fy, scene.fz])
+    enc = Encoder(pop, 1000.0, dt=DT, engine="direct", seed=0)
+    enc.push(forces[:200])  # warm-up (numba kernels)
+    enc.reset()
+    enc.wait_ready()  # a stimulator bridge primes the encoder before the stream starts
+    laps = np.empty(forces.shape[0])
+    t0 = time.perf_counter()
+    for k in range(forces.shape[0]):
+        wait = t0 + k * 1e-3 - time.perf_counter()  # the next sample arrives at k ms
+        if wait > 3e-4:
+            time.sleep(wait - 2e-4)  # sleep, not spin: leave the GIL to the noise prefetch
+        while time.perf_counter() < t0 + k * 1e-3:
+            pass
+        start = time.perf_counter()
+        enc.push(forces[k:k + 1])
+        laps[k] = time.perf_counter() - start
+    return {"name": f"stream_{population}", "engine": "direct", "n_afferents": len(pop), "sim_s": seconds,
+            "dt_ms": DT * 1e3, "wall_s": round(float(laps.sum()), 3),
+            "afferent_s_per_wall_s": round(len(pop) * seconds / float(laps.sum()), 1),
+            "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
+            "chunk_ms": 1.0, "median_ms": round(float(np.median(laps)) * 1e3, 4),
+            "p99_ms": round(float(np.percentile(laps, 99)) * 1e3, 4), "max_ms": round(float(laps.max()) * 1e3, 3)}
+
+
+def run_extra(name: str) -> dict:
+    """Run one of `EXTRA_CASES` in this process."""
+    if name.startswith("scale_100k"):
+        return _scale_case(0 if name.endswith("inprocess") else int(name.split("_")[-1][0]))
+    return _stream_case(name.split("_", 1)[1])
 
 
 def _subprocess_case(name: str) -> dict:
@@ -98,10 +186,10 @@ def _cold_main(engine: str, out: str) -> None:
 
 def run_bench(cases=None) -> dict:
     """All cases, each in a fresh process, plus the cold starts."""
-    names = list(CASES) if cases is None else list(cases)
+    names = list(CASES) + list(EXTRA_CASES) if cases is None else list(cases)
     results = [_subprocess_case(n) for n in names]
     one_time = {}
-    for engine in ("direct", "brian2"):
+    for engine in ("direct", "brian2") if cases is None else ():
         case, extra = _cold_start(engine)
         results.append(case)
         one_time[f"first_process_extra_s_{engine}"] = extra
@@ -111,15 +199,23 @@ def run_bench(cases=None) -> dict:
         ratios["brian2_over_direct_hand_1s"] = round(by["hand_1s_brian2"]["wall_s"] / by["hand_1s_direct"]["wall_s"], 2)
     if "hand_1s_direct" in by:
         ratios["touchsim_hand_over_direct"] = round(TOUCHSIM_SPEED["hand_wall_s"] / by["hand_1s_direct"]["wall_s"], 2)
+    if "scale_100k_inprocess" in by and "scale_100k_2workers" in by:
+        ratios["speedup_2workers_over_inprocess_100k"] = round(
+            by["scale_100k_inprocess"]["wall_s"] / by["scale_100k_2workers"]["wall_s"], 2)
     return {"cases": results, "ratios": ratios, "one_time": one_time}
 
 
 def _table(result: dict) -> str:
-    lines = ["| case | engine | afferents | sim (s) | wall (s) | afferent-s/s | peak RSS (MB) |",
-             "|---|---|---|---|---|---|---|"]
+    lines = ["| case | engine | afferents | sim (s) | wall (s) | afferent-s/s | peak RSS (MB) | notes |",
+             "|---|---|---|---|---|---|---|---|"]
     for c in result["cases"]:
+        notes = []
+        if "median_ms" in c:
+            notes.append(f"per 1 ms chunk: median {c['median_ms']:.3f} ms, p99 {c['p99_ms']:.3f} ms")
+        if "peak_rss_per_worker_mb" in c:
+            notes.append(f"{c['workers']} workers, peak {c['peak_rss_per_worker_mb']:.0f} MB per worker")
         lines.append(f"| {c['name']} | {c['engine']} | {c['n_afferents']} | {c['sim_s']:g} | {c['wall_s']:.3f} "
-                     f"| {c['afferent_s_per_wall_s']:.0f} | {c['peak_rss_mb']:.0f} |")
+                     f"| {c['afferent_s_per_wall_s']:.0f} | {c['peak_rss_mb']:.0f} | {'; '.join(notes)} |")
     lines += [f"{k}: {v}" for k, v in {**result["ratios"], **result["one_time"]}.items()]
     return "\n".join(lines)
 
@@ -128,15 +224,15 @@ def register(sub) -> None:
     """Add ``ddmm bench``."""
     p = sub.add_parser("bench", help="speed and memory of the whole pipeline (fresh process per case)")
     p.add_argument("--json", action="store_true")
-    p.add_argument("--cases", default=None, help="comma-separated subset of: " + ", ".join(CASES))
+    p.add_argument("--cases", default=None, help="comma-separated subset of: " + ", ".join([*CASES, *EXTRA_CASES]))
     p.set_defaults(func=_run)
 
 
 def _run(args) -> int:
     cases = None if args.cases is None else [c.strip() for c in args.cases.split(",")]
     for c in cases or []:
-        if c not in CASES:
-            raise ValueError(f"--cases: {c!r} is unknown; allowed: {', '.join(CASES)}")
+        if c not in CASES and c not in EXTRA_CASES:
+            raise ValueError(f"--cases: {c!r} is unknown; allowed: {', '.join([*CASES, *EXTRA_CASES])}")
     result = run_bench(cases)
     print(json.dumps(result) if args.json else _table(result))
     return 0
@@ -144,10 +240,12 @@ def _run(args) -> int:
 
 if __name__ == "__main__":  # pragma: no cover - the per-case subprocess entries
     parser = argparse.ArgumentParser()
-    parser.add_argument("--case", choices=sorted(CASES))
+    parser.add_argument("--case", choices=sorted([*CASES, *EXTRA_CASES]))
     parser.add_argument("--cold", nargs=2, metavar=("ENGINE", "OUT"))
     cli_args = parser.parse_args()
     if cli_args.cold:
         _cold_main(*cli_args.cold)
+    elif cli_args.case in EXTRA_CASES:
+        print(json.dumps(run_extra(cli_args.case)))
     else:
         print(json.dumps(run_case(cli_args.case)))

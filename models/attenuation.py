@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._validation import as_finite_array, check_choice, check_positive
-from .nap import boundary_radius, get_profile, tip_radius, validate_k
+from .nap import get_profile, radius_core, tip_radius, validate_k
 
 __all__ = [
     "F_TH",
@@ -27,6 +27,7 @@ __all__ = [
     "shear_magnitude",
     "attenuation_factor",
     "attenuated_force",
+    "af_core",
 ]
 
 #: Shear threshold F_TH in newtons below which no direction is defined (eq. 17).
@@ -121,14 +122,23 @@ def attenuation_factor(
         return af
     ux, uy, inverse = _unique_directions(fx, fy, active)
     rad = np.deg2rad(theta)
-    ct, st = np.cos(rad), np.sin(rad)
-    cos_phi = ux[:, None] * ct + uy[:, None] * st
-    sin_phi = uy[:, None] * ct - ux[:, None] * st
-    radius = boundary_radius(sin_phi, cos_phi, prof, k) / tip_radius(prof)
+    params = (prof.p1, prof.p2, prof.p3, prof.p4, prof.p5)
+    af[active] = af_core(ux[:, None], uy[:, None], np.cos(rad), np.sin(rad), k, params, tip_radius(prof))[inverse]
+    return af
+
+
+def af_core(ux, uy, cos_t, sin_t, k, params, tip) -> np.ndarray:
+    """AF for unit shear vectors (ux, uy) against tips at (cos_t, sin_t); no validation.
+
+    ``params`` are p1..p5 (scalars or per-afferent arrays) and ``tip`` the
+    profile's tip radius.  The one implementation offline and streaming share.
+    """
+    cos_phi = ux * cos_t + uy * sin_t
+    sin_phi = uy * cos_t - ux * sin_t
+    radius = radius_core(sin_phi, cos_phi, k, *params) / tip
     # For k < 1 (theta_A > 90 deg with b = 1) a profile is wider than its tip
     # is long, so r(phi) > r(0) off-axis; AF saturates at 1 (no attenuation).
-    af[active] = np.minimum(radius, 1.0)[inverse]
-    return af
+    return np.minimum(radius, 1.0)
 
 
 def attenuated_force(fz, af) -> np.ndarray:

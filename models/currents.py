@@ -15,7 +15,11 @@ Derivatives of a raw force signal are useless (DDMM-NOTES §1.6), so F_A is
 low-passed first by a *causal* Butterworth filter and differentiated by
 backward differences.  Both keep explicit state (`FilterState`), so a signal
 cut into chunks gives exactly the currents of the whole signal: streaming and
-offline runs agree bit for bit.
+offline runs agree bit for bit.  SciPy designs the filter; a small numba
+kernel runs it (direct form II transposed, SciPy's algorithm), because the
+streaming encoder calls it once per millisecond and ``sosfilt``'s ~0.1 ms call
+overhead alone would exceed its latency budget.  Offline and streaming use the
+same kernel, so their arithmetic is identical by construction.
 
 Currents are in the Izhikevich model's own units (mV/ms, the units of
 ``dv/dt`` in eq. 4); the gains convert newtons to them.
@@ -26,6 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 
+import numba as nb
 import numpy as np
 from scipy import signal
 
@@ -39,6 +44,7 @@ __all__ = [
     "initial_filter_state",
     "filter_force",
     "afferent_current",
+    "current_core",
 ]
 
 #: The afferent types of the model, in the order used throughout the package.
@@ -162,10 +168,54 @@ def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams())
     return FilterState(zi=np.zeros((sos.shape[0], 2, f0.size)), offset=f0, y1=zeros, y2=zeros.copy())
 
 
+@nb.njit(cache=True, nogil=True)
+def _sos_kernel(sos, x, zi):
+    """Filter ``x`` (samples, channels) along axis 0; ``zi`` (sections, 2, channels) is updated."""
+    y = np.empty_like(x)
+    for n in range(x.shape[0]):
+        for j in range(x.shape[1]):
+            cur = x[n, j]
+            for s in range(sos.shape[0]):
+                new = sos[s, 0] * cur + zi[s, 0, j]
+                zi[s, 0, j] = sos[s, 1] * cur - sos[s, 4] * new + zi[s, 1, j]
+                zi[s, 1, j] = sos[s, 2] * cur - sos[s, 5] * new
+                cur = new
+            y[n, j] = cur
+    return y
+
+
+@nb.njit(cache=True, nogil=True)
+def _derivative_kernel(sos, f_a, offset, zi, y1, y2, fs, order):
+    """Filter the deviation from ``offset`` and take backward differences, in one pass.
+
+    ``zi``, ``y1`` and ``y2`` carry the state and are updated in place; the
+    arithmetic is that of `_sos_kernel` followed by the differences
+    ``(y - y1) fs`` (order 1) or ``(y - 2 y1 + y2) fs^2`` (order 2).
+    """
+    out = np.empty_like(f_a)
+    fs2 = fs * fs
+    for n in range(f_a.shape[0]):
+        for j in range(f_a.shape[1]):
+            cur = f_a[n, j] - offset[j]
+            for s in range(sos.shape[0]):
+                new = sos[s, 0] * cur + zi[s, 0, j]
+                zi[s, 0, j] = sos[s, 1] * cur - sos[s, 4] * new + zi[s, 1, j]
+                zi[s, 1, j] = sos[s, 2] * cur - sos[s, 5] * new
+                cur = new
+            if order == 1:
+                out[n, j] = (cur - y1[j]) * fs
+            else:
+                out[n, j] = ((cur - 2.0 * y1[j]) + y2[j]) * fs2
+            y2[j] = y1[j]
+            y1[j] = cur
+    return out
+
+
 def _filter_deviation(f_a, fs, params, state: FilterState):
     """Low-passed deviation from ``state.offset`` and the state after it."""
-    sos = lowpass_sos(params.cutoff_hz, params.filter_order, fs)
-    dev, zi = signal.sosfilt(sos, f_a - state.offset, axis=0, zi=state.zi)
+    sos = _butter_sos(float(params.cutoff_hz), int(params.filter_order), fs)
+    zi = state.zi.copy()
+    dev = _sos_kernel(sos, np.ascontiguousarray(f_a - state.offset), zi)
     n = dev.shape[0]
     y1 = dev[-1].copy() if n >= 1 else state.y1
     y2 = dev[-2].copy() if n >= 2 else (state.y1 if n == 1 else state.y2)
@@ -199,26 +249,6 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
         state = initial_filter_state(f_a[0], fs, params)
     dev, new_state = _filter_deviation(f_a, fs, params, state)
     return dev + state.offset, new_state
-
-
-def _backward_differences(dev, fs, state: FilterState, order: int) -> np.ndarray:
-    """First (order=1) or second (order=2) backward difference, per second^order.
-
-    ``state`` holds the two samples before ``dev``, so chunks join exactly.
-    """
-    prev1 = np.empty_like(dev)  # dev shifted by one sample
-    prev1[:1] = state.y1
-    prev1[1:] = dev[:-1]
-    if order == 1:
-        out = dev - prev1
-        out *= fs
-        return out
-    prev2 = np.empty_like(dev)  # shifted by two
-    prev2[:2] = np.stack([state.y2, state.y1])[: dev.shape[0]]
-    prev2[2:] = dev[:-2]
-    out = dev - 2.0 * prev1 + prev2
-    out *= fs * fs
-    return out
 
 
 def afferent_current(
@@ -264,6 +294,11 @@ def afferent_current(
     check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
     fs = check_positive(fs, "fs", "Hz")
     f_a = as_finite_array(f_a, "f_a", ndim=2)
+    return current_core(f_a, fs, afferent_type, params, state, scale)
+
+
+def current_core(f_a, fs, afferent_type, params, state=None, scale=None):
+    """`afferent_current` without validation (the streaming encoder's hot path)."""
     gain = params.gain(afferent_type)
     if scale is not None:
         gain = gain * np.asarray(scale, dtype=float)
@@ -272,9 +307,11 @@ def afferent_current(
         return _saturate(gain * np.abs(f_a), i_sat), None
     if state is None:
         state = initial_filter_state(f_a[0], fs, params)
-    dev, new_state = _filter_deviation(f_a, fs, params, state)
-    order = 1 if afferent_type == "RAI" else 2
-    deriv = _backward_differences(dev, fs, state, order)
+    sos = _butter_sos(float(params.cutoff_hz), int(params.filter_order), fs)
+    zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
+    deriv = _derivative_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, float(fs),
+                               1 if afferent_type == "RAI" else 2)
+    new_state = FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2)
     return _saturate(gain * np.abs(deriv), i_sat), new_state
 
 

@@ -18,7 +18,7 @@ from ._validation import as_finite_array, check_choice, check_positive
 from .neuron import V_FLOOR, V_PEAK, NeuronParams, neuron_arrays, resting_state
 
 __all__ = ["ENGINES", "METHODS", "MAX_NEGATIVE_DRIVE_MV", "NeuronState", "SpikeResult", "NumericalInstabilityError", "SpikeCapWarning",
-           "substeps_for", "prepare", "integrate"]
+           "substeps_for", "prepare", "integrate", "check_integration", "check_stability"]
 
 ENGINES = ("brian2", "direct")
 #: Largest negative drive per step, dt * (-I) in mV, that the multi-stage methods
@@ -194,7 +194,7 @@ def integrate(
     params = neuron_arrays(types, neuron_params)
     v, u = _initial_state(state, params["b"], n)
     current = np.ascontiguousarray(current)
-    _check_stability(current, dt, method)
+    check_stability(current, dt, method)
     if n == 0 or current.shape[0] == 0:
         neuron = step = np.empty(0, np.int64)
     elif engine == "direct":
@@ -205,11 +205,11 @@ def integrate(
         from .brian2_engine import run_brian2
 
         neuron, step = run_brian2(current, substeps, dt, params, v, u, method=method, v_peak=V_PEAK, v_floor=V_FLOOR)
-    _check(neuron, step, v, u, current, method, dt)
+    check_integration(neuron, step, v, u, current, method, dt)
     return SpikeResult(neuron, step, NeuronState(v, u), dt, current.shape[0] * substeps)
 
 
-def _check_stability(current, dt, method) -> None:
+def check_stability(current, dt, method) -> None:
     """Refuse negative drives a multi-stage method cannot integrate (see MAX_NEGATIVE_DRIVE_MV)."""
     if method == "euler" or current.size == 0:
         return
@@ -222,8 +222,8 @@ def _check_stability(current, dt, method) -> None:
         )
 
 
-def _check(neuron, step, v, u, current, method, dt) -> None:
-    """Never hand back NaN; warn when the one-spike-per-step cap bound."""
+def check_integration(neuron, step, v, u, current, method, dt) -> None:
+    """Never hand back NaN (raise); warn when the one-spike-per-step cap bound."""
     if not (np.all(np.isfinite(v)) and np.all(np.isfinite(u))):
         bad = int(np.flatnonzero(~(np.isfinite(v) & np.isfinite(u)))[0])
         raise NumericalInstabilityError(

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 
 __all__ = [
@@ -29,6 +30,7 @@ __all__ = [
     "k_from_selectivity",
     "selectivity_from_k",
     "boundary_radius",
+    "radius_core",
     "tip_radius",
 ]
 
@@ -212,18 +214,35 @@ def boundary_radius(sin_phi, cos_phi, profile: str | NAPProfile, k) -> np.ndarra
     """
     prof = get_profile(profile)
     k = validate_k(k, prof)
-    s = np.abs(np.asarray(sin_phi, dtype=float))
-    c = np.asarray(cos_phi, dtype=float)
-    p1, p2, p3, p4, p5 = prof.p1, prof.p2, prof.p3, prof.p4, prof.p5
-    ks = k * s
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r_hi = p1 * (p3 + p4) / (p1 * ks + (p1 * p2 - p5) * c)
-        r_lo = p1 * (p4 - p3) / (p1 * ks - (p1 * p2 + p5) * c)
-        ok_hi = np.isfinite(r_hi) & (r_hi > 0.0) & (p2 * c * r_hi >= p3)
-        ok_lo = np.isfinite(r_lo) & (r_lo > 0.0) & (p2 * c * r_lo < p3)
-    r = np.minimum(np.where(ok_hi, r_hi, np.inf), np.where(ok_lo, r_lo, np.inf))
+    r = radius_core(np.asarray(sin_phi, dtype=float), np.asarray(cos_phi, dtype=float), k,
+                    prof.p1, prof.p2, prof.p3, prof.p4, prof.p5)
     if not np.all(np.isfinite(r)):  # pragma: no cover - geometry guarantees a root
         raise FloatingPointError(f"no boundary root for the {prof.name} profile")
+    return r
+
+
+@nb.vectorize(["float64(float64, float64, float64, float64, float64, float64, float64, float64)"], cache=True)
+def radius_core(sin_phi, cos_phi, k, p1, p2, p3, p4, p5):
+    """`boundary_radius` without validation, as a ufunc (profile parameters broadcast).
+
+    The one implementation of the closed form: `boundary_radius`, offline
+    attenuation (per profile) and the streaming encoder (all afferents at
+    once) all call it, so every path does the same arithmetic.  A piece whose
+    denominator is 0 has no root (inf).
+    """
+    s = abs(sin_phi)
+    ks = k * s
+    d_hi = p1 * ks + (p1 * p2 - p5) * cos_phi
+    d_lo = p1 * ks - (p1 * p2 + p5) * cos_phi
+    r = np.inf
+    if d_hi != 0.0:
+        r_hi = p1 * (p3 + p4) / d_hi
+        if np.isfinite(r_hi) and r_hi > 0.0 and p2 * cos_phi * r_hi >= p3:
+            r = r_hi
+    if d_lo != 0.0:
+        r_lo = p1 * (p4 - p3) / d_lo
+        if np.isfinite(r_lo) and r_lo > 0.0 and p2 * cos_phi * r_lo < p3 and r_lo < r:
+            r = r_lo
     return r
 
 

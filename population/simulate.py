@@ -268,7 +268,7 @@ def _expand(cond, members, the_plan, block, deterministic, result):
 
 def simulate(population, scenes, *, engine="brian2", dt=None, method=None, tolerance=None, trials=1, seed=None,
              record=RECORD_CHOICES, no_shear="pass", types=None, plan=True, chunk_size=4096,
-             time_chunk=2000, quiet=False):
+             time_chunk=2000, scheduler=None, quiet=False):
     """Simulate a population on one or more scenes.
 
     Parameters
@@ -301,6 +301,10 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
         Skip what provably does not matter (default); False runs everything.
     chunk_size, time_chunk : int
         Afferents and samples per chunk (results do not depend on them).
+    scheduler : None, "processes", distributed.Client or str
+        Where the afferent blocks run: in this process (default), a local
+        pool of worker processes, a Dask client, or a scheduler address
+        (`population.distributed`).  The Dataset is bit-identical either way.
     quiet : bool
         Hide the progress bar (shown on stderr for runs over about a second).
 
@@ -329,20 +333,32 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
                         chunk_size=chunk_size, time_chunk=time_chunk, plan=plan)
     spikes = [[] for _ in scenes]
     members = [_unit_members(cond) for cond in the_plan.conditions]
-    prepare(engine)  # engine imports that must happen in the main thread
+    work = list(_jobs(population, scenes, the_plan))
     with tqdm(total=the_plan.work(), unit="aff-sample", unit_scale=True, delay=1.0, file=sys.stderr,
-              disable=quiet, leave=False) as bar, ThreadPoolExecutor(max_workers=_PIPELINE) as pool:
+              disable=quiet, leave=False) as bar:
+        results = _run_jobs([job for _, job, _, _ in work], config, scheduler, bar.update)
+    for (c, _, block, det), result in zip(work, results):
+        spikes[c].append(_expand(the_plan.conditions[c], members[c], the_plan, block, det, result))
+    ds = build_dataset(population, scenes, the_plan, spikes, config)
+    ds.attrs.update(choice)
+    return ds
+
+
+def _run_jobs(jobs, config, scheduler, progress) -> list:
+    """Results of every job, in order: in this process, or as Dask tasks."""
+    if scheduler is not None:
+        from .distributed import dask_client, run_distributed
+
+        with dask_client(scheduler) as client:
+            return run_distributed(client, jobs, config, run_chunk, progress)
+    prepare(config.engine)  # engine imports that must happen in the main thread
+    with ThreadPoolExecutor(max_workers=_PIPELINE) as pool:
         # Two blocks in flight: one block's currents and noise (numpy) are
         # computed while the other integrates (numba threads, or the Brian2
         # binary in its own process).  Blocks are independent, so the order
         # of completion cannot change a spike.
-        running = [(c, block, det, pool.submit(run_chunk, job, config, bar.update))
-                   for c, job, block, det in _jobs(population, scenes, the_plan)]
-        for c, block, det, future in running:
-            spikes[c].append(_expand(the_plan.conditions[c], members[c], the_plan, block, det, future.result()))
-    ds = build_dataset(population, scenes, the_plan, spikes, config)
-    ds.attrs.update(choice)
-    return ds
+        futures = [pool.submit(run_chunk, job, config, progress) for job in jobs]
+        return [f.result() for f in futures]
 
 
 def _resolve_step(dt, method, tolerance, scenes):

@@ -1,0 +1,278 @@
+"""A streaming encoder: live fingertip force in, spikes out, with bounded latency.
+
+`Encoder` keeps the whole pipeline's state between calls: the derivative
+filters, every neuron's (v, u), and each afferent's noise stream.  Because
+the filter is causal and every stage carries its state, the concatenated
+spikes of *any* chunking equal the offline `simulate` run of the whole
+signal with the same seed (condition 0, trial 0), bit for bit.
+
+Noise is drawn ahead in blocks (``noise_block`` samples per afferent) from
+the same per-afferent streams as offline, on a background thread while the
+previous block is consumed, so a chunk only slices a ready block and drawing
+(hundreds of ms for a whole hand) never stalls the stream.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from models._validation import as_finite_array, check_choice, check_positive
+from models.attenuation import F_TH, NO_SHEAR_READINGS, UNTUNED, af_core
+from models.currents import current_core
+from models.direct import _BLOCK, _METHOD_CODES, _integrate_range
+from models.engines import (ENGINES, METHODS, NeuronState, check_integration, check_stability, integrate, prepare,
+                            substeps_for)
+from models.nap import get_profile, tip_radius
+from models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
+
+from .noise import draw_noise, noise_streams, root_seed
+from .sampling import Population
+from .scenes import Contact
+from .simulate import _grouped, _runs
+
+__all__ = ["StreamSpikes", "Encoder"]
+
+_PREFETCH = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ddmm-noise-prefetch")
+
+
+@dataclass(frozen=True)
+class StreamSpikes:
+    """Spikes of one pushed chunk.
+
+    Attributes
+    ----------
+    afferent : ndarray of int64
+        Position of the spiking afferent in the encoder's population.
+    time : ndarray of float
+        Spike time in seconds since the first sample (``step * dt``).
+    """
+
+    afferent: np.ndarray
+    time: np.ndarray
+
+
+class Encoder:
+    """Turn streamed force samples into spikes, chunk by chunk.
+
+    Parameters
+    ----------
+    population : Population
+        The afferents.
+    fs : float
+        Sample rate of the force stream in Hz.
+    dt : float
+        Integration step in seconds (must divide ``1/fs``).
+    engine : {"direct", "brian2"}
+        Simulation engine (direct by default: it is the low-latency one).
+    method : str
+        Integration scheme.
+    seed : int, Generator or None
+        Root of the noise streams (as in `simulate`).
+    no_shear : {"pass", "block"}
+        Reading of eq. 17.
+    contact : Contact, optional
+        Fixed contact geometry, for receptive-field weighting.
+    noise_block : int
+        Noise samples drawn ahead per afferent.
+
+    Examples
+    --------
+    >>> from population import make_population
+    >>> enc = Encoder(make_population(["SAI"]), fs=1000.0, engine="direct", seed=1)
+    >>> out = enc.push(np.column_stack([np.zeros(300), np.zeros(300), np.full(300, 4.0)]))
+    >>> bool(out.afferent.size > 0)
+    True
+    """
+
+    def __init__(self, population, fs: float, *, dt: float = 1e-4, engine: str = "direct", method: str = "euler",
+                 seed=None, no_shear: str = "pass", contact: Contact | None = None, noise_block: int = 1000):
+        if not isinstance(population, Population):
+            raise TypeError(f"population must be a Population, got {type(population).__name__}")
+        self.fs = check_positive(fs, "fs", "Hz")
+        self.substeps = substeps_for(self.fs, dt)
+        self.dt, self.engine = float(dt), check_choice(engine, "engine", ENGINES)
+        self.method = check_choice(method, "method", METHODS)
+        self.no_shear = check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
+        if contact is not None and not isinstance(contact, Contact):
+            raise TypeError(f"contact must be a Contact or None, got {type(contact).__name__}")
+        self.seed, self.contact, self.noise_block = root_seed(seed), contact, int(noise_block)
+        idx = np.arange(len(population))
+        self._order = _grouped(population, idx, idx)  # contiguous (type, NAP) groups, as offline
+        self._pop = population.select(self._order)
+        self._precompute()
+        prepare(engine)
+        self.reset()
+
+    def _precompute(self) -> None:
+        """Per-afferent constants of the fast path (same values the offline path uses)."""
+        pop = self._pop
+        self._tuned = np.flatnonzero(pop.nap != UNTUNED)
+        rad = np.deg2rad(pop.theta_t[self._tuned])
+        self._cos_t, self._sin_t = np.cos(rad), np.sin(rad)
+        profiles = [get_profile(n) for n in pop.nap[self._tuned]]
+        self._params = tuple(np.array([getattr(p, f) for p in profiles]) for f in ("p1", "p2", "p3", "p4", "p5"))
+        tips = {name: tip_radius(name) for name in set(pop.nap[self._tuned].tolist())}
+        self._tip = np.array([tips[n] for n in pop.nap[self._tuned]])
+        self._k = pop.k[self._tuned]
+        weights = None
+        if self.contact is not None:
+            from .spatial import receptive_field_weight
+
+            weights = receptive_field_weight(pop.x_mm, pop.y_mm, pop.afferent_type, self.contact)
+        self._scale = pop.gain if weights is None else pop.gain * weights
+        self._groups = [(kind, cols) for kind, cols in _runs(pop.afferent_type)]
+        self._neuron_params = neuron_arrays(pop.afferent_type)
+        self._h, self._half = 1.0 * self.dt / 0.001, (1.0 * (0.5 * self.dt)) / 0.001  # as run_direct computes them
+
+    def reset(self) -> None:
+        """Back to the start: filters unset, neurons at rest, noise streams rewound."""
+        if getattr(self, "_pending", None) is not None:
+            self._pending.result()  # let an in-flight draw finish before its streams are dropped
+        self._pending = None
+        self._filters, self._neuron, self._samples, self._last_time = {}, None, 0, None
+        noisy = np.any(self._pop.noise_sigma > 0)
+        self._streams = noise_streams(self.seed, 0, 0, self._pop.afferent_id) if noisy else None
+        self._blocks = deque()  # noise drawn ahead, oldest first; rows before _noise_pos are used
+        self._noise_pos = 0
+        if self._streams is not None:
+            self._prefetch(self.noise_block)  # the first block is drawn before the first chunk arrives
+
+    def wait_ready(self) -> None:
+        """Block until the noise drawn ahead is ready (call before a real-time loop starts)."""
+        if self._pending is not None:
+            self._blocks.append(self._pending.result())
+            self._pending = None
+
+    @property
+    def n_samples(self) -> int:
+        """Samples consumed since the start (or the last reset)."""
+        return self._samples
+
+    def _peek_noise(self, n: int) -> np.ndarray:
+        """The next ``n`` noise rows, drawing ahead as needed but consuming nothing.
+
+        Draws advance the generators, so drawn rows are kept until used: a
+        push that fails later leaves the noise sequence exactly where it was.
+        Blocks are queued, never concatenated (a hand's block is 100 MB).
+        """
+        while sum(b.shape[0] for b in self._blocks) - self._noise_pos < n:
+            if self._pending is None:
+                self._prefetch(max(self.noise_block, n))
+            self._blocks.append(self._pending.result())
+            self._pending = None
+        parts, start, need = [], self._noise_pos, n
+        for block in self._blocks:
+            take = min(need, block.shape[0] - start)
+            parts.append(block[start:start + take])
+            need, start = need - take, 0
+            if need == 0:
+                break
+        ahead = sum(b.shape[0] for b in self._blocks) - self._noise_pos - n
+        if self._pending is None and ahead < self.noise_block:
+            self._prefetch(self.noise_block)  # keep a whole block drawn ahead of the one in use
+        return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+    def _consume_noise(self, n: int) -> None:
+        self._noise_pos += n
+        while self._blocks and self._noise_pos >= self._blocks[0].shape[0]:
+            self._noise_pos -= self._blocks.popleft().shape[0]
+
+    def _prefetch(self, rows: int) -> None:
+        """Start drawing the next ``rows`` noise samples on the background thread (one draw at a time)."""
+        self._pending = _PREFETCH.submit(draw_noise, self._streams, self._pop.noise_sigma, rows, self.fs)
+
+    def _validate(self, forces, times):
+        forces = as_finite_array(forces, "forces")
+        if forces.ndim != 2 or forces.shape[1] != 3:
+            raise ValueError(f"forces must have shape (n, 3) for (fx, fy, fz), got {forces.shape}")
+        if np.any(forces[:, 2] < 0):
+            raise ValueError("forces: the normal force fz must be >= 0 N")
+        if times is not None:
+            times = as_finite_array(times, "times", ndim=1)
+            if times.size != forces.shape[0]:
+                raise ValueError(f"times must have one entry per sample; got {times.size} for {forces.shape[0]}")
+            previous = np.r_[self._last_time if self._last_time is not None else -np.inf, times]
+            if np.any(np.diff(previous) <= 0):
+                raise ValueError("times must increase strictly, continuing from the previous chunk")
+        return forces, times
+
+    def push(self, forces, times=None) -> StreamSpikes:
+        """Consume a chunk of samples; return the spikes that fell inside it.
+
+        Parameters
+        ----------
+        forces : array_like, shape (n, 3)
+            F_X, F_Y, F_Z in newtons, one row per sample at ``fs``.
+        times : array_like, shape (n,), optional
+            Sample times in seconds, checked to increase strictly across
+            chunks (the encoder's clock is the sample count, not these).
+
+        Raises
+        ------
+        ValueError
+            For non-finite values, a negative normal force, a wrong shape or
+            time going backwards; the encoder's state is left untouched.
+        """
+        forces, times = self._validate(forces, times)
+        n = forces.shape[0]
+        if n == 0:
+            return StreamSpikes(np.empty(0, np.int64), np.empty(0))
+        filters = dict(self._filters)  # committed only if the whole chunk succeeds
+        current = self._currents(forces, filters)
+        if self._streams is not None:
+            current += self._peek_noise(n)
+        afferent, step, v, u = self._integrate(current)
+        step0 = self._samples * self.substeps
+        self._filters, self._neuron = filters, NeuronState(v, u)
+        if self._streams is not None:
+            self._consume_noise(n)
+        self._samples += n
+        if times is not None:
+            self._last_time = float(times[-1])
+        afferent, step = self._order[afferent], step + step0
+        if afferent.size > 1:
+            order = np.lexsort((afferent, step))
+            afferent, step = afferent[order], step[order]
+        return StreamSpikes(afferent, step * self.dt)
+
+    def _currents(self, forces, filters) -> np.ndarray:
+        """Currents of a chunk: the offline arithmetic (`af_core`, `current_core`) without its checks."""
+        fx, fy, fz = forces[:, 0], forces[:, 1], forces[:, 2]
+        n, n_aff = forces.shape[0], len(self._pop)
+        af = np.ones((n, n_aff))
+        if self._tuned.size:
+            mag = np.hypot(fx, fy)
+            active = mag > F_TH
+            af[:, self._tuned] = 1.0 if self.no_shear == "pass" else 0.0
+            if active.any():
+                ux, uy = fx[active] / mag[active], fy[active] / mag[active]
+                af[np.ix_(active, self._tuned)] = af_core(ux[:, None], uy[:, None], self._cos_t, self._sin_t,
+                                                          self._k, self._params, self._tip)
+        f_a = af * fz[:, None]
+        current = np.empty_like(f_a)
+        for i, (kind, cols) in enumerate(self._groups):
+            current[:, cols], filters[i] = current_core(f_a[:, cols], self.fs, kind, self._pop.current,
+                                                        filters.get(i), self._scale[cols])
+        return current
+
+    def _integrate(self, current):
+        """Advance the neurons; the direct engine is called without the seam's per-call set-up."""
+        if self.engine != "direct":
+            res = integrate(current, fs=self.fs, dt=self.dt, afferent_type=self._pop.afferent_type,
+                            engine=self.engine, method=self.method, state=self._neuron)
+            return res.afferent, res.step, res.state.v, res.state.u
+        if self._neuron is None:
+            v, u = (np.array(x, dtype=float) for x in resting_state(self._neuron_params["b"]))
+        else:
+            v, u = self._neuron.v.copy(), self._neuron.u.copy()
+        check_stability(current, self.dt, self.method)
+        p = self._neuron_params
+        afferent, step = _integrate_range(np.ascontiguousarray(current), self.substeps, _METHOD_CODES[self.method],
+                                          self._h, self._half, p["a"], p["b"], p["c"], p["d"], v, u, V_PEAK, V_FLOOR,
+                                          _BLOCK, 0, v.size)
+        check_integration(afferent, step, v, u, current, self.method, self.dt)
+        return afferent, step, v, u

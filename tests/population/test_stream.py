@@ -1,0 +1,91 @@
+"""The streaming encoder: any chunking equals the offline run; bad chunks leave no trace."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from population import Scene, press_push_lift, sample_population, simulate
+from population.stream import Encoder
+from tests.conftest import ENGINES
+
+N = 3000
+
+
+@pytest.fixture(scope="module")
+def setup():
+    pop = sample_population("fingertip", rng=0).select(np.arange(0, 955, 7))
+    ppl = press_push_lift(90.0)
+    scene = Scene(ppl.fx[4000:4000 + N], ppl.fy[4000:4000 + N], ppl.fz[4000:4000 + N], 1000.0, "x")
+    forces = np.column_stack([scene.fx, scene.fy, scene.fz])
+    offline = {e: simulate(pop, scene, engine=e, seed=3, quiet=True) for e in ENGINES}
+    return pop, forces, offline
+
+
+def concat(outs):
+    return np.concatenate([o.afferent for o in outs]), np.concatenate([o.time for o in outs])
+
+
+@settings(max_examples=12, deadline=None)
+@given(cuts=st.lists(st.integers(1, N - 1), max_size=25, unique=True), engine=st.sampled_from(["direct"] * 3 + ["brian2"]))
+def test_any_chunking_equals_offline(setup, cuts, engine):
+    pop, forces, offline = setup
+    enc = Encoder(pop, 1000.0, engine=engine, seed=3)
+    edges = [0] + sorted(cuts) + [N]
+    aff, t = concat([enc.push(forces[a:b]) for a, b in zip(edges[:-1], edges[1:])])
+    np.testing.assert_array_equal(aff, offline[engine].spike_afferent.values)
+    np.testing.assert_array_equal(t, offline[engine].spike_time.values)
+
+
+def test_bad_chunks_do_not_corrupt_the_state(setup):
+    pop, forces, offline = setup
+    enc = Encoder(pop, 1000.0, engine="direct", seed=3)
+    times = np.arange(N) / 1000.0
+    outs = [enc.push(forces[:1000], times=times[:1000])]
+    bad = forces[1000:1100].copy()
+    bad[50, 1] = np.nan
+    with pytest.raises(ValueError, match="finite"):
+        enc.push(bad, times=times[1000:1100])
+    with pytest.raises(ValueError, match="increase strictly"):
+        enc.push(forces[1000:1100], times=times[900:1000])
+    with pytest.raises(ValueError, match="shape"):
+        enc.push(forces[1000:1100, :2])
+    outs.append(enc.push(forces[1000:], times=times[1000:]))
+    aff, t = concat(outs)
+    np.testing.assert_array_equal(t, offline["direct"].spike_time.values)
+    np.testing.assert_array_equal(aff, offline["direct"].spike_afferent.values)
+
+
+def test_reset_starts_over(setup):
+    pop, forces, _ = setup
+    enc = Encoder(pop, 1000.0, engine="direct", seed=3)
+    first = enc.push(forces[:800])
+    enc.reset()
+    again = enc.push(forces[:800])
+    np.testing.assert_array_equal(first.time, again.time)
+    assert enc.n_samples == 800
+
+
+def test_encoder_bad_arguments(setup):
+    pop, _, _ = setup
+    with pytest.raises(TypeError, match="population"):
+        Encoder("fingertip", 1000.0)
+    with pytest.raises(ValueError, match="dt"):
+        Encoder(pop, 1000.0, dt=3e-4)
+    with pytest.raises(ValueError, match="engine"):
+        Encoder(pop, 1000.0, engine="nest")
+
+
+def test_cli_stream(capsys, monkeypatch):
+    import io
+
+    from experiments.cli import main
+    t = np.arange(0, 0.3, 0.001)
+    fz = np.interp(t, [0, 0.1, 0.3], [0, 4, 4])
+    lines = ["t,fx,fy,fz"] + [f"{a:.3f},0,{0.3 * b:.4f},{b:.4f}" for a, b in zip(t, fz)] + ["0.1,0,0,1", "x"]
+    monkeypatch.setattr("sys.stdin", io.StringIO("\n".join(lines) + "\n"))
+    assert main(["stream", "--fs", "1000", "--seed", "2"]) == 0
+    out, err = capsys.readouterr()
+    rows = [r.split(",") for r in out.strip().splitlines()]
+    assert len(rows) > 50 and {r[2] for r in rows} <= {"SAI", "RAI", "RAII"}
+    assert "line 302 skipped" in err and "line 303 skipped" in err
