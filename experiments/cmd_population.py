@@ -36,6 +36,8 @@ def _add_run_options(p, *, out_required: bool) -> None:
     p.add_argument("--no-shear", choices=("pass", "block"), default="pass")
     p.add_argument("--types", default=None, metavar="T[,T...]", help="afferent types to simulate")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--scheduler", default=None, metavar="processes|ADDRESS",
+                   help="run afferent blocks on Dask: a local pool of processes or a scheduler address")
     p.add_argument("--out", required=out_required, metavar="FILE.nc")
 
 
@@ -131,7 +133,7 @@ def run_simulate(args) -> int:
     start = time.perf_counter()
     ds = simulate(pop, scenes, engine=args.engine, dt=None if args.dt is None else args.dt * 1e-3,
                   method=args.method, tolerance=args.tolerance, trials=args.trials, seed=args.seed,
-                  no_shear=args.no_shear, types=_types(args.types), quiet=args.quiet)
+                  no_shear=args.no_shear, types=_types(args.types), quiet=args.quiet, scheduler=args.scheduler)
     save_dataset(ds, out)
     if not args.quiet:
         choice = f"; {ds.attrs['tolerance_choice']}" if "tolerance_choice" in ds.attrs else ""

@@ -15,10 +15,11 @@ profile ``"none"``.
 
 from __future__ import annotations
 
+import numba as nb
 import numpy as np
 
 from ._validation import as_finite_array, check_choice, check_positive
-from .nap import get_profile, radius_core, tip_radius, validate_k
+from .nap import get_profile, radius_scalar, tip_radius, validate_k
 
 __all__ = [
     "F_TH",
@@ -123,22 +124,35 @@ def attenuation_factor(
     ux, uy, inverse = _unique_directions(fx, fy, active)
     rad = np.deg2rad(theta)
     params = (prof.p1, prof.p2, prof.p3, prof.p4, prof.p5)
-    af[active] = af_core(ux[:, None], uy[:, None], np.cos(rad), np.sin(rad), k, params, tip_radius(prof))[inverse]
+    af[active] = af_core(ux, uy, np.cos(rad), np.sin(rad), k, params, tip_radius(prof))[inverse]
     return af
 
 
-def af_core(ux, uy, cos_t, sin_t, k, params, tip) -> np.ndarray:
-    """AF for unit shear vectors (ux, uy) against tips at (cos_t, sin_t); no validation.
+@nb.njit(cache=True, nogil=True)
+def _af_kernel(ux, uy, cos_t, sin_t, k, p1, p2, p3, p4, p5, tip):
+    out = np.empty((ux.size, cos_t.size))
+    for i in range(ux.size):
+        for j in range(cos_t.size):
+            cos_phi = ux[i] * cos_t[j] + uy[i] * sin_t[j]
+            sin_phi = uy[i] * cos_t[j] - ux[i] * sin_t[j]
+            r = radius_scalar(sin_phi, cos_phi, k[j], p1[j], p2[j], p3[j], p4[j], p5[j]) / tip[j]
+            # For k < 1 (theta_A > 90 deg with b = 1) a profile is wider than its
+            # tip is long, so r(phi) > r(0) off-axis; AF saturates at 1.
+            out[i, j] = min(r, 1.0)
+    return out
 
-    ``params`` are p1..p5 (scalars or per-afferent arrays) and ``tip`` the
-    profile's tip radius.  The one implementation offline and streaming share.
+
+def af_core(ux, uy, cos_t, sin_t, k, params, tip) -> np.ndarray:
+    """AF, shape (n_directions, n_afferents), for unit shear vectors (ux, uy); no validation.
+
+    ``cos_t``, ``sin_t`` give each afferent's tip direction, ``k`` its
+    sharpness, ``params`` p1..p5 and ``tip`` the tip radius (scalars or
+    per-afferent arrays).  The one implementation offline and streaming share.
     """
-    cos_phi = ux * cos_t + uy * sin_t
-    sin_phi = uy * cos_t - ux * sin_t
-    radius = radius_core(sin_phi, cos_phi, k, *params) / tip
-    # For k < 1 (theta_A > 90 deg with b = 1) a profile is wider than its tip
-    # is long, so r(phi) > r(0) off-axis; AF saturates at 1 (no attenuation).
-    return np.minimum(radius, 1.0)
+    ux, uy = np.ravel(ux).astype(float), np.ravel(uy).astype(float)
+    n = np.size(cos_t)
+    per = [np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=float), (n,))) for x in (k, *params, tip)]
+    return _af_kernel(ux, uy, np.ravel(cos_t).astype(float), np.ravel(sin_t).astype(float), *per)
 
 
 def attenuated_force(fz, af) -> np.ndarray:

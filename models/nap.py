@@ -31,6 +31,7 @@ __all__ = [
     "selectivity_from_k",
     "boundary_radius",
     "radius_core",
+    "radius_scalar",
     "tip_radius",
 ]
 
@@ -221,14 +222,12 @@ def boundary_radius(sin_phi, cos_phi, profile: str | NAPProfile, k) -> np.ndarra
     return r
 
 
-@nb.vectorize(["float64(float64, float64, float64, float64, float64, float64, float64, float64)"], cache=True)
-def radius_core(sin_phi, cos_phi, k, p1, p2, p3, p4, p5):
-    """`boundary_radius` without validation, as a ufunc (profile parameters broadcast).
+def _radius(sin_phi, cos_phi, k, p1, p2, p3, p4, p5):
+    """The closed form of eq. 9 along one ray (scalars); see `boundary_radius`.
 
-    The one implementation of the closed form: `boundary_radius`, offline
-    attenuation (per profile) and the streaming encoder (all afferents at
-    once) all call it, so every path does the same arithmetic.  A piece whose
-    denominator is 0 has no root (inf).
+    The one implementation: compiled as the scalar `radius_scalar` (used by
+    the attenuation kernel) and as the ufunc `radius_core`, so every path
+    does the same arithmetic.  A piece whose denominator is 0 has no root.
     """
     s = abs(sin_phi)
     ks = k * s
@@ -244,6 +243,12 @@ def radius_core(sin_phi, cos_phi, k, p1, p2, p3, p4, p5):
         if np.isfinite(r_lo) and r_lo > 0.0 and p2 * cos_phi * r_lo < p3 and r_lo < r:
             r = r_lo
     return r
+
+
+radius_scalar = nb.njit(cache=True, nogil=True)(_radius)
+#: `boundary_radius` without validation, as a ufunc (profile parameters broadcast).
+radius_core = nb.vectorize(["float64(float64, float64, float64, float64, float64, float64, float64, float64)"],
+                           cache=True)(_radius)
 
 
 def tip_radius(profile: str | NAPProfile) -> float:

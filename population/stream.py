@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from models._validation import as_finite_array, check_choice, check_positive
-from models.attenuation import F_TH, NO_SHEAR_READINGS, UNTUNED, af_core
+from models.attenuation import F_TH, NO_SHEAR_READINGS, UNTUNED, _af_kernel
 from models.currents import current_core
 from models.direct import _BLOCK, _METHOD_CODES, _integrate_range
 from models.engines import (ENGINES, METHODS, NeuronState, check_integration, check_stability, integrate, prepare,
@@ -118,6 +118,8 @@ class Encoder:
         tips = {name: tip_radius(name) for name in set(pop.nap[self._tuned].tolist())}
         self._tip = np.array([tips[n] for n in pop.nap[self._tuned]])
         self._k = pop.k[self._tuned]
+        self._af_args = tuple(np.ascontiguousarray(x, dtype=float) for x in
+                              (self._cos_t, self._sin_t, self._k, *self._params, self._tip))
         weights = None
         if self.contact is not None:
             from .spatial import receptive_field_weight
@@ -250,8 +252,7 @@ class Encoder:
             af[:, self._tuned] = 1.0 if self.no_shear == "pass" else 0.0
             if active.any():
                 ux, uy = fx[active] / mag[active], fy[active] / mag[active]
-                af[np.ix_(active, self._tuned)] = af_core(ux[:, None], uy[:, None], self._cos_t, self._sin_t,
-                                                          self._k, self._params, self._tip)
+                af[np.ix_(active, self._tuned)] = _af_kernel(ux, uy, *self._af_args)  # af_core's kernel
         f_a = af * fz[:, None]
         current = np.empty_like(f_a)
         for i, (kind, cols) in enumerate(self._groups):
