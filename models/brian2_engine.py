@@ -91,7 +91,6 @@ class _Build:
     directory: Path
     group: object
     monitor: object
-    timed_array: object
     device: object  # the cpp_standalone device that built the project
     n_neurons: int
     n_samples: int
@@ -222,8 +221,7 @@ def _build(key: tuple) -> _Build:
         net.run(n_samples * substeps * dt * b2.second, namespace={"ddmm_current": ta, "ms": b2.ms})
         standalone.build(directory=str(directory), run=False, with_output=False)
         b2.set_device("runtime")  # leave the user's Brian2 in its default mode
-    return _Build(key, directory, group, monitor, ta, standalone, n_neurons, n_samples,
-                  n_samples * substeps * dt)
+    return _Build(key, directory, group, monitor, standalone, n_neurons, n_samples, n_samples * substeps * dt)
 
 
 def _activate(key: tuple) -> _Build:

@@ -169,28 +169,13 @@ def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams())
 
 
 @nb.njit(cache=True, nogil=True)
-def _sos_kernel(sos, x, zi):
-    """Filter ``x`` (samples, channels) along axis 0; ``zi`` (sections, 2, channels) is updated."""
-    y = np.empty_like(x)
-    for n in range(x.shape[0]):
-        for j in range(x.shape[1]):
-            cur = x[n, j]
-            for s in range(sos.shape[0]):
-                new = sos[s, 0] * cur + zi[s, 0, j]
-                zi[s, 0, j] = sos[s, 1] * cur - sos[s, 4] * new + zi[s, 1, j]
-                zi[s, 1, j] = sos[s, 2] * cur - sos[s, 5] * new
-                cur = new
-            y[n, j] = cur
-    return y
-
-
-@nb.njit(cache=True, nogil=True)
 def _derivative_kernel(sos, f_a, offset, zi, y1, y2, fs, order):
-    """Filter the deviation from ``offset`` and take backward differences, in one pass.
+    """Filter the deviation from ``offset`` (direct form II transposed, SciPy's
+    ``sosfilt`` arithmetic) and return it (order 0) or its backward difference
+    ``(y - y1) fs`` (order 1) or ``(y - 2 y1 + y2) fs^2`` (order 2), in one pass.
 
-    ``zi``, ``y1`` and ``y2`` carry the state and are updated in place; the
-    arithmetic is that of `_sos_kernel` followed by the differences
-    ``(y - y1) fs`` (order 1) or ``(y - 2 y1 + y2) fs^2`` (order 2).
+    ``zi`` (sections, 2, channels), ``y1`` and ``y2`` carry the state and are
+    updated in place.
     """
     out = np.empty_like(f_a)
     fs2 = fs * fs
@@ -202,7 +187,9 @@ def _derivative_kernel(sos, f_a, offset, zi, y1, y2, fs, order):
                 zi[s, 0, j] = sos[s, 1] * cur - sos[s, 4] * new + zi[s, 1, j]
                 zi[s, 1, j] = sos[s, 2] * cur - sos[s, 5] * new
                 cur = new
-            if order == 1:
+            if order == 0:
+                out[n, j] = cur
+            elif order == 1:
                 out[n, j] = (cur - y1[j]) * fs
             else:
                 out[n, j] = ((cur - 2.0 * y1[j]) + y2[j]) * fs2
@@ -211,15 +198,12 @@ def _derivative_kernel(sos, f_a, offset, zi, y1, y2, fs, order):
     return out
 
 
-def _filter_deviation(f_a, fs, params, state: FilterState):
-    """Low-passed deviation from ``state.offset`` and the state after it."""
+def _run_kernel(f_a, fs, params, state: FilterState, order: int):
+    """`_derivative_kernel` on copies of the state; returns (output, new state)."""
     sos = _butter_sos(float(params.cutoff_hz), int(params.filter_order), fs)
-    zi = state.zi.copy()
-    dev = _sos_kernel(sos, np.ascontiguousarray(f_a - state.offset), zi)
-    n = dev.shape[0]
-    y1 = dev[-1].copy() if n >= 1 else state.y1
-    y2 = dev[-2].copy() if n >= 2 else (state.y1 if n == 1 else state.y2)
-    return dev, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2)
+    zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
+    out = _derivative_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, float(fs), order)
+    return out, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2)
 
 
 def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=None):
@@ -247,7 +231,7 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
     f_a = as_finite_array(f_a, "f_a", ndim=2)
     if state is None:
         state = initial_filter_state(f_a[0], fs, params)
-    dev, new_state = _filter_deviation(f_a, fs, params, state)
+    dev, new_state = _run_kernel(f_a, fs, params, state, 0)
     return dev + state.offset, new_state
 
 
@@ -307,11 +291,7 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None):
         return _saturate(gain * np.abs(f_a), i_sat), None
     if state is None:
         state = initial_filter_state(f_a[0], fs, params)
-    sos = _butter_sos(float(params.cutoff_hz), int(params.filter_order), fs)
-    zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
-    deriv = _derivative_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, float(fs),
-                               1 if afferent_type == "RAI" else 2)
-    new_state = FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2)
+    deriv, new_state = _run_kernel(f_a, fs, params, state, 1 if afferent_type == "RAI" else 2)
     return _saturate(gain * np.abs(deriv), i_sat), new_state
 
 

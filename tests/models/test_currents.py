@@ -97,3 +97,17 @@ def test_bad_rates_and_types():
         afferent_current(np.zeros((3, 1)), FS, "SAII")
     with pytest.raises(ValueError, match="f_a"):
         afferent_current(np.array([[np.nan]]), FS, "SAI")
+
+
+def test_filter_kernel_matches_scipy_sosfilt():
+    from scipy import signal
+
+    from models.currents import filter_force, initial_filter_state
+    rng = np.random.default_rng(0)
+    f = rng.normal(size=(400, 5)).cumsum(axis=0)
+    for order, cutoff in ((2, 20.0), (4, 35.0)):
+        params = CurrentParams(cutoff_hz=cutoff, filter_order=order)
+        sos = lowpass_sos(cutoff, order, FS)
+        expected, _ = signal.sosfilt(sos, f - f[0], axis=0, zi=np.zeros((sos.shape[0], 2, 5)))
+        got, _ = filter_force(f, FS, params, initial_filter_state(f[0], FS, params))
+        np.testing.assert_array_equal(got, expected + f[0])  # filter_force returns deviation + offset
