@@ -27,7 +27,7 @@ import json
 import numpy as np
 from scipy.optimize import brentq
 
-from models.currents import AFFERENT_TYPES, CurrentParams
+from models.currents import PAPER_TYPES, CurrentParams
 from models.engines import integrate, substeps_for
 from models.metrics import spiking_frequency
 from models.pipeline import compute_currents
@@ -39,7 +39,7 @@ from .reproduce import ReproConfig, reproduce_all
 __all__ = ["CMM_TARGETS", "cmm_sf", "fit_gains", "cutoff_effect", "transducer_scan", "main"]
 
 #: Paper Table III, CMM column (pulses/s).
-CMM_TARGETS = {t: PAPER_TABLE3["cmm"][t][0] for t in AFFERENT_TYPES}
+CMM_TARGETS = {t: PAPER_TABLE3["cmm"][t][0] for t in PAPER_TYPES}
 _GAIN_FIELD = {"SAI": "g_sai", "RAI": "g_rai", "RAII": "g_raii"}
 _BRACKETS = {"SAI": (0.5, 50.0), "RAI": (0.5, 1000.0), "RAII": (0.05, 10000.0)}
 
@@ -57,7 +57,7 @@ def cmm_sf(kind: str, params: CurrentParams, dt: float = 1e-4) -> float:
 def fit_gains(params: CurrentParams = CurrentParams(), targets=CMM_TARGETS) -> CurrentParams:
     """Fit each gain so the CMM SF of its type crosses the target (Brent's method)."""
     fitted = {}
-    for kind in AFFERENT_TYPES:
+    for kind in PAPER_TYPES:
         field = _GAIN_FIELD[kind]
 
         def excess(g, kind=kind, field=field):
@@ -77,7 +77,7 @@ def cutoff_effect(params: CurrentParams, cutoffs=(10.0, 20.0, 40.0, 80.0)) -> di
         for no_shear in ("pass", "block"):
             sf = reproduce_all(ReproConfig(engine="direct", no_shear=no_shear, current_params=cp))
             t3 = sf["table3"]["sf"]
-            row[no_shear] = {p: {t: round(t3[p][t]["75"] - t3[p][t]["255"], 2) for t in AFFERENT_TYPES}
+            row[no_shear] = {p: {t: round(t3[p][t]["75"] - t3[p][t]["255"], 2) for t in PAPER_TYPES}
                              for p in ("selective", "broad")}
         out[f"{cutoff:g}"] = row
     return out
@@ -90,7 +90,7 @@ def _table_checks(params: CurrentParams) -> dict:
         res = reproduce_all(ReproConfig(engine="direct", no_shear=no_shear, current_params=params))
         t2, t3 = res["table2"]["prsi"], res["table3"]["sf"]
         tuned = ("selective", "broad")
-        ordered = AFFERENT_TYPES if no_shear == "block" else ("SAI",)
+        ordered = PAPER_TYPES if no_shear == "block" else ("SAI",)
         checks[no_shear] = {
             "prsi_in_range": all(0.2 <= t2[p][t] <= 0.7 for p in tuned for t in ("SAI", "RAI")),
             "aligned_gt_misaligned": all(t3[p][t]["75"] > t3[p][t]["255"] for p in tuned for t in ordered),
@@ -114,7 +114,7 @@ def transducer_scan(settings=((None, 20.0), (100.0, 20.0), (50.0, 20.0), (50.0, 
         params = fit_gains(CurrentParams(i_sat=i_sat, cutoff_hz=cutoff))
         peaks = {f"{name}_{kind}": _peak_rate(params, scene, kind)
                  for name, scene in (("birznieks", birznieks(90.0)), ("ppl", press_push_lift(90.0)))
-                 for kind in AFFERENT_TYPES}
+                 for kind in PAPER_TYPES}
         rows.append({"i_sat": i_sat, "cutoff_hz": cutoff,
                      "gains": {f: getattr(params, f) for f in ("g_sai", "g_rai", "g_raii")},
                      "checks": _table_checks(params), "peak_rate_10ms": peaks})
@@ -128,7 +128,7 @@ def main(argv=None) -> int:
                         help="also refit for compressive transducers and report peak rates")
     args = parser.parse_args(argv)
     params = fit_gains()
-    achieved = {t: round(cmm_sf(t, params), 2) for t in AFFERENT_TYPES}
+    achieved = {t: round(cmm_sf(t, params), 2) for t in PAPER_TYPES}
     report = {
         "fitted": {f: getattr(params, f) for f in ("g_sai", "g_rai", "g_raii")},
         "cutoff_hz": params.cutoff_hz,

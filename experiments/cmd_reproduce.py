@@ -6,7 +6,7 @@ import json
 import sys
 import warnings
 
-from models.currents import AFFERENT_TYPES
+from models.currents import PAPER_TYPES
 from models.engines import SpikeCapWarning
 
 from .io import ensure_out_dir, save_figure, save_json
@@ -36,7 +36,7 @@ def format_table2(result: dict) -> str:
     prsi = result["prsi"]
     lines = ["| type | " + " | ".join(f"{p} ours (paper)" for p in PROFILES) + " | human DSI |",
              "|---" * (len(PROFILES) + 2) + "|"]
-    for t in AFFERENT_TYPES:
+    for t in PAPER_TYPES:
         cells = [f"{prsi[p][t]:.2f} ({PAPER_TABLE2[p][t]:.2f})" for p in PROFILES]
         lines.append(f"| {t} | " + " | ".join(cells) + f" | {_HUMAN_DSI[t]} |")
     return "\n".join(lines)
@@ -47,7 +47,7 @@ def format_table3(result: dict) -> str:
     sf = result["sf"]
     lines = ["| type | " + " | ".join(f"{p} 75° / 255° ours (paper)" for p in PROFILES) + " |",
              "|---" * (len(PROFILES) + 1) + "|"]
-    for t in AFFERENT_TYPES:
+    for t in PAPER_TYPES:
         cells = []
         for p in PROFILES:
             a, b = sf[p][t]["75"], sf[p][t]["255"]
@@ -63,7 +63,7 @@ def format_fig8(result: dict) -> str:
     lines = ["| profile | type | peak theta_T | SF min-max (pulses/s) | SF(θ) = SF(θ+180°) |",
              "|---|---|---|---|---|"]
     for p in PROFILES:
-        for t in AFFERENT_TYPES:
+        for t in PAPER_TYPES:
             curve = {float(a): v for a, v in sf[p][t].items()}
             peak = max(curve, key=curve.get)
             sym = all(curve[a] == curve[(a + 180.0) % 360.0] for a in curve)

@@ -14,6 +14,7 @@ __all__ = [
     "HUMAN_DIRECTION_THRESHOLD_DEG",
     "TOUCHSIM_COUNTS",
     "TOUCHSIM_SPEED",
+    "PHYSIOLOGY_REFERENCE",
 ]
 
 #: NAP boundary radii at k = 3 for phi = 0, 15, 30, 45, 60, 90, 120, 150, 165,
@@ -66,3 +67,63 @@ TOUCHSIM_SPEED = {
     "hand_peak_gb": 2.8,
     "import_to_first_result_s": (3.5, 4.8),
 }
+
+
+def _physiology_reference() -> dict:
+    """Reference ranges of the physiology scorecard (`population.physiology`), from ``shared/PHYSIOLOGY.md``.
+
+    Rows marked R there are recalled, not read: they become broad ranges here.
+    Roles: ``fitted`` (an objective of ``ddmm calibrate``), ``constrained``
+    (bounds the calibration or was set by hand from it), ``held out`` (never in
+    any objective or hand setting).
+    """
+    from population.physiology import Reference as R
+
+    inf = float("inf")
+    rest = "PHYSIOLOGY.md row 1 (Vallbo & Johansson 1984; Knibestol 1975); row 2 (foot sole, V)"
+    onoff = "PHYSIOLOGY.md rows 3-5 (Westling & Johansson 1987; J Neurosci 3:2652)"
+    rates = "PHYSIOLOGY.md row 5: no afferent sustains rates near 1 kHz; bar 500 pulses/s"
+    tuned = "PHYSIOLOGY.md rows 10-11 (Birznieks et al. 2001 via the DDMM paper)"
+    return {
+        "rest_rate_RAI": R(0.0, 0.0, rest, "constrained", "R"),
+        "rest_rate_RAII": R(0.0, 0.0, rest, "constrained", "R"),
+        "rest_rate_SAI": R(0.0, 1.0, rest, "constrained", "R"),
+        "rest_silent_SAI": R(0.9, 1.0, rest, "constrained", "R"),
+        "rest_rate_SAII": R(5.0, 20.0, rest + "; SA-II bias set by hand to it", "constrained", "R"),
+        "hold_ratio_RAI": R(0.0, 0.1, onoff, "constrained", "R"),
+        "release_fraction_RAI": R(0.5, 1.0, onoff, "constrained", "R"),
+        "off_transient_RAII": R(0.0, 0.0, onoff + ": FA-II fire only at transients (within 100 ms)", "constrained", "R"),
+        "hold_rate_SAI": R(10.0, 60.0, "PHYSIOLOGY.md row 5: SA-I plateau 10-60 imp/s at 2-4 N", "constrained", "R"),
+        "adaptation_SAI": R(0.0, 0.99, "PHYSIOLOGY.md row 4: SA-I adapt through a hold (V, monkey)", "constrained", "V"),
+        "max_rate_SAI": R(0.0, 500.0, rates, "constrained", "R"),
+        "max_rate_RAI": R(0.0, 500.0, rates, "constrained", "R"),
+        "max_rate_RAII": R(0.0, 500.0, rates, "constrained", "R"),
+        "max_rate_SAII": R(0.0, 500.0, rates, "constrained", "R"),
+        "capped_spikes": R(0.0, 0.0, "nothing near one spike per integration step", "constrained", "R"),
+        "force_coding_SAI": R(1.05, inf, "PHYSIOLOGY.md row 6: SA-I rates rise with normal force (shape only)",
+                              "held out", "V"),
+        "rate_coding_RAI": R(1.05, inf, "PHYSIOLOGY.md row 6: FA-I responses grow with indentation rate",
+                             "held out", "V"),
+        "best_frequency_RAI": R(8.0, 64.0, "PHYSIOLOGY.md row 8 (Johansson, Landstrom & Lundstrom 1982)",
+                                "held out", "V"),
+        "best_frequency_RAII": R(150.0, 400.0, "PHYSIOLOGY.md row 8: FA-II best around 200-300 Hz", "held out", "V"),
+        "tuned_SAI": R(0.89, 0.97, tuned + ": 93 +- 4%", "fitted", "R"),
+        "tuned_RAI": R(0.79, 0.87, tuned + ": 83 +- 4%", "fitted", "R"),
+        "dsi_mean_SAI": R(0.20, 0.26, tuned + ": 0.23 +- 0.03", "fitted", "V"),
+        "dsi_sd_SAI": R(0.13, 0.23, tuned + ": SD 0.18 +- 0.05", "fitted", "V"),
+        "dsi_mean_RAI": R(0.21, 0.27, tuned + ": 0.24 +- 0.03", "fitted", "V"),
+        "dsi_sd_RAI": R(0.13, 0.23, tuned + ": SD 0.18 +- 0.05", "fitted", "V"),
+        "tuned_SAII": R(0.5, 1.0, "PHYSIOLOGY.md rows 9, 12: most SA-II direction tuned (broad range, R)",
+                        "held out", "R"),
+        "tuned_recorded": R(0.83, 0.89, tuned + ": 86% pooled over SA-I, SA-II and FA-I; not independent of the "
+                            "fitted SA-I and FA-I rows", "held out", "R"),
+        "latency_vs_count": R(0.0, 1.5, "PHYSIOLOGY.md row 13 (Saal et al. 2009): first spike ~ counts",
+                              "held out", "V"),
+        "jitter_RAI": R(0.3, 10.0, "PHYSIOLOGY.md row 14: jitter of a few ms", "held out", "R"),
+        "continuity": R(0.0, 0.01, "issue 9: F_A continuous for continuous forces (a 0.1 ms sample moves it "
+                        "< 0.01 N)", "held out", "V"),
+    }
+
+
+#: Reference ranges of ``ddmm physiology``, by property name.
+PHYSIOLOGY_REFERENCE = _physiology_reference()

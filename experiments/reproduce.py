@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from models.attenuation import UNTUNED
-from models.currents import AFFERENT_TYPES, CurrentParams
+from models.currents import PAPER_TYPES, CurrentParams
 from models.engines import integrate, substeps_for
 from models.metrics import direction_index, spiking_frequency
 from models.pipeline import compute_currents
@@ -77,7 +77,7 @@ def scene_sf(scene: Scene, theta_ts, config: ReproConfig = ReproConfig(), profil
     theta_ts = np.asarray(theta_ts, dtype=float)
     blocks, types = [], []
     for profile in profiles:
-        for kind in AFFERENT_TYPES:
+        for kind in PAPER_TYPES:
             blocks.append(compute_currents(
                 scene.fx, scene.fy, scene.fz, fs=scene.fs, afferent_type=kind,
                 profile=_model_profile(profile), theta_t=theta_ts, k=config.k,
@@ -89,8 +89,8 @@ def scene_sf(scene: Scene, theta_ts, config: ReproConfig = ReproConfig(), profil
                        engine=config.engine)
     sf = spiking_frequency(result.step, current.shape[1], fz=scene.fz, fs=scene.fs,
                            substeps=substeps_for(scene.fs, config.dt), afferent=result.afferent)
-    sf = sf.reshape(len(profiles), len(AFFERENT_TYPES), theta_ts.size)
-    table = {p: {t: sf[i, j] for j, t in enumerate(AFFERENT_TYPES)} for i, p in enumerate(profiles)}
+    sf = sf.reshape(len(profiles), len(PAPER_TYPES), theta_ts.size)
+    table = {p: {t: sf[i, j] for j, t in enumerate(PAPER_TYPES)} for i, p in enumerate(profiles)}
     return table, result
 
 
@@ -100,7 +100,7 @@ def table2(config: ReproConfig = ReproConfig()) -> dict:
     Returns ``{"prsi": {profile: {type: value}}}``.
     """
     sf, _ = scene_sf(birznieks(90.0), [0.0, 90.0, 180.0, 270.0], config)
-    prsi = {p: {t: round(float(direction_index(*sf[p][t])), 4) for t in AFFERENT_TYPES} for p in sf}
+    prsi = {p: {t: round(float(direction_index(*sf[p][t])), 4) for t in PAPER_TYPES} for p in sf}
     return {"prsi": prsi}
 
 
@@ -117,7 +117,7 @@ def table3(config: ReproConfig = ReproConfig(), sf=None) -> dict:
     angles = [75.0, 255.0]
     sf = _press_push_lift_sf(angles, config) if sf is None else sf
     return {"sf": {p: {t: {f"{a:g}": _sf_at(sf, p, t, a, angles) for a in angles}
-                       for t in AFFERENT_TYPES} for p in sf}}
+                       for t in PAPER_TYPES} for p in sf}}
 
 
 def _sf_at(sf, profile, kind, angle, angles):
@@ -132,14 +132,14 @@ def fig8(config: ReproConfig = ReproConfig(), sf=None) -> dict:
     angles = [float(a) for a in FIG8_ANGLES]
     sf = _press_push_lift_sf(angles, config) if sf is None else sf
     return {"sf": {p: {t: {f"{a:g}": _sf_at(sf, p, t, a, angles) for a in angles}
-                       for t in AFFERENT_TYPES} for p in sf}}
+                       for t in PAPER_TYPES} for p in sf}}
 
 
 def reproduce_all(config: ReproConfig = ReproConfig()) -> dict:
     """All three reproductions; Table III is read from the Fig. 8 run (75 and 255 are on its grid)."""
     angles = [float(a) for a in FIG8_ANGLES]
     sf = _press_push_lift_sf(angles, config)
-    sub = {p: {t: sf[p][t][[angles.index(75.0), angles.index(255.0)]] for t in AFFERENT_TYPES} for p in sf}
+    sub = {p: {t: sf[p][t][[angles.index(75.0), angles.index(255.0)]] for t in PAPER_TYPES} for p in sf}
     return {"table2": table2(config), "table3": table3(config, sub), "fig8": fig8(config, sf)}
 
 
@@ -164,7 +164,7 @@ def response_data(scene: Scene, profile: str, angles, config: ReproConfig = Repr
     conditions = []
     for j, (label, theta) in enumerate(angles):
         spikes = {kind: result.time[result.afferent == i * len(angles) + j]
-                  for i, kind in enumerate(AFFERENT_TYPES)}
+                  for i, kind in enumerate(PAPER_TYPES)}
         conditions.append({"label": f"{profile}, {label} (theta_T = {theta:g} deg)",
                            "af": af[:, j], "spikes": spikes})
     return {"time": scene.time, "forces": {"fx": scene.fx, "fy": scene.fy, "fz": scene.fz},

@@ -8,6 +8,18 @@ shear" (DDMM-NOTES §1.5), selected by ``no_shear``:
 * ``"pass"`` (default, eq. 17): AF = 1, normal loading passes unattenuated.
 * ``"block"`` (the Discussion's reading): AF = 0, nothing passes until shear
   appears.
+* ``"smooth"`` (ours, the populations' default): AF moves continuously from
+  1 to the profile's value as F_S grows through F_TH,
+  ``AF = 1 + w(F_S) (AF_profile - 1)`` with the C1 ramp
+  ``w = smoothstep(F_S / (2 F_TH))`` (0 at F_S = 0, 1/2 at F_TH, 1 from
+  2 F_TH on).  Under eq. 17 F_A steps within one sample when the shear
+  crosses F_TH, a strong dynamic stimulus that makes every RA afferent
+  burst whatever its tuning; with the ramp F_A is continuous whenever the
+  forces are.
+
+SA-II (Ruffini) afferents are driven by skin stretch, from forces the
+attenuated *shear* (`stretch_drive`); it needs no threshold, since it
+vanishes with F_S.
 
 The conventional model (CMM) is the same pipeline with AF = 1 everywhere:
 profile ``"none"``.
@@ -29,12 +41,17 @@ __all__ = [
     "attenuation_factor",
     "attenuated_force",
     "af_core",
+    "transition_weight",
+    "blend_no_shear",
+    "profile_factor",
+    "stretch_drive",
 ]
 
 #: Shear threshold F_TH in newtons below which no direction is defined (eq. 17).
 F_TH = 0.1
-#: The two readings of "no shear" (DDMM-NOTES §1.5); eq. 17 ("pass") is the default.
-NO_SHEAR_READINGS = ("pass", "block")
+#: The readings of "no shear": the paper's two (DDMM-NOTES §1.5; eq. 17, "pass", is
+#: the default of `models`) and our continuous one ("smooth", the populations' default).
+NO_SHEAR_READINGS = ("pass", "block", "smooth")
 #: Profile name of an untuned afferent, i.e. the CMM (AF = 1).
 UNTUNED = "none"
 
@@ -87,8 +104,9 @@ def attenuation_factor(
         Sharpness of eq. 12 (dimensionless), default 3 as in the paper.
     f_th : float
         Shear threshold F_TH in newtons (default 0.1 N, eq. 17).
-    no_shear : {"pass", "block"}
-        AF when F_S <= F_TH: 1 (eq. 17) or 0 (the Discussion's reading).
+    no_shear : {"pass", "block", "smooth"}
+        AF when F_S <= F_TH: 1 (eq. 17) or 0 (the Discussion's reading), or
+        the continuous transition of the module docstring.
 
     Returns
     -------
@@ -101,6 +119,28 @@ def attenuation_factor(
     >>> af.round(3).tolist()
     [[1.0, 1.0], [1.0, 0.2]]
     """
+    fx, fy, theta = _check_shear(fx, fy, theta_t)
+    f_th = check_positive(f_th, "f_th", "N")
+    check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
+    return _factor(fx, fy, theta, profile, k, f_th, no_shear)
+
+
+def profile_factor(fx, fy, theta_t, profile: str, k=3.0) -> np.ndarray:
+    """The profile's own AF, r(phi)/r(0), wherever F_S > 0, with no threshold (1 where F_S = 0).
+
+    SA-II's stretch drive uses it: it is multiplied by F_S, so it needs no
+    threshold to vanish at zero shear.  Arguments as `attenuation_factor`.
+
+    Examples
+    --------
+    >>> profile_factor([0.0, 0.0], [0.0, 0.05], [270.0], "selective").round(3).tolist()
+    [[1.0], [0.2]]
+    """
+    fx, fy, theta = _check_shear(fx, fy, theta_t)
+    return _factor(fx, fy, theta, profile, k, 0.0, "raw")
+
+
+def _check_shear(fx, fy, theta_t):
     fx = as_finite_array(fx, "fx", ndim=1)
     fy = as_finite_array(fy, "fy", ndim=1)
     if fx.shape != fy.shape:
@@ -108,13 +148,17 @@ def attenuation_factor(
     theta = np.atleast_1d(as_finite_array(theta_t, "theta_t"))
     if theta.ndim != 1:
         raise ValueError(f"theta_t must be a scalar or 1-D, got shape {theta.shape}")
-    f_th = check_positive(f_th, "f_th", "N")
-    check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
+    return fx, fy, theta
+
+
+def _factor(fx, fy, theta, profile, k, f_th, mode):
+    """AF under ``mode``: "pass", "block", "smooth" or "raw" (the profile wherever F_S > 0)."""
     if profile != UNTUNED:
         prof = get_profile(profile)
         k = np.broadcast_to(validate_k(k, prof), theta.shape)
-    active = shear_magnitude(fx, fy) > f_th
-    outside = 1.0 if (no_shear == "pass" or profile == UNTUNED) else 0.0
+    mag = shear_magnitude(fx, fy)
+    active = mag > (0.0 if mode in ("smooth", "raw") else f_th)
+    outside = 0.0 if (mode == "block" and profile != UNTUNED) else 1.0
     af = np.full((fx.size, theta.size), outside)
     if profile == UNTUNED:
         af[active] = 1.0
@@ -124,8 +168,47 @@ def attenuation_factor(
     ux, uy, inverse = _unique_directions(fx, fy, active)
     rad = np.deg2rad(theta)
     params = (prof.p1, prof.p2, prof.p3, prof.p4, prof.p5)
-    af[active] = af_core(ux, uy, np.cos(rad), np.sin(rad), k, params, tip_radius(prof))[inverse]
+    profile_af = af_core(ux, uy, np.cos(rad), np.sin(rad), k, params, tip_radius(prof))[inverse]
+    af[active] = blend_no_shear(profile_af, mag[active], f_th) if mode == "smooth" else profile_af
     return af
+
+
+def transition_weight(f_s, f_th: float = F_TH) -> np.ndarray:
+    """Weight w of the profile in the "smooth" reading: smoothstep(F_S / (2 F_TH)).
+
+    0 at F_S = 0, 1/2 at F_TH and 1 from 2 F_TH on, with zero slope at both
+    ends (F_S and F_TH in newtons).
+
+    Examples
+    --------
+    >>> transition_weight([0.0, 0.1, 0.2, 1.0]).tolist()
+    [0.0, 0.5, 1.0, 1.0]
+    """
+    x = np.clip(np.asarray(f_s, dtype=float) / (2.0 * f_th), 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def blend_no_shear(profile_af, f_s, f_th: float = F_TH) -> np.ndarray:
+    """AF of the "smooth" reading from the profile's AF (rows: samples) and F_S (N)."""
+    w = transition_weight(f_s, f_th)
+    return 1.0 + w[:, None] * (profile_af - 1.0)
+
+
+def stretch_drive(fx, fy, af, opponent: float = 0.0) -> np.ndarray:
+    """SA-II's signed stretch drive ``F_S (AF - opponent (1 - AF))`` in newtons.
+
+    ``af`` is the profile's AF (shape (n_samples, n_afferents)) on the shear
+    direction; stretch along the preferred direction drives the afferent,
+    stretch against it lowers the drive when ``opponent > 0``.
+
+    Examples
+    --------
+    >>> stretch_drive([0.0], [2.0], [[1.0, 0.0]], opponent=0.5).tolist()
+    [[2.0, -1.0]]
+    """
+    f_s = shear_magnitude(fx, fy)
+    af = np.asarray(af, dtype=float)
+    return f_s[:, None] * (af - opponent * (1.0 - af))
 
 
 @nb.njit(cache=True, nogil=True)

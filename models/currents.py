@@ -1,25 +1,51 @@
-"""Afferent currents from the attenuated force (paper eqs 1-3).
+"""Afferent currents from the attenuated force (paper eqs 1-3), and type-specific stages.
+
+The paper's stage (the default of `CurrentParams`):
 
 * SAI follows force:            ``I = g_sai * |F_A|``           (eq. 1)
 * RAI its rate of change:       ``I = g_rai * |dF_A/dt|``       (eq. 2)
 * RAII its acceleration:        ``I = g_raii * |d^2F_A/dt^2|``  (eq. 3)
 
-By default the drive is used as is (the paper's linear eqs).  An optional
-compressive transducer ``I = i_sat * log1p(x / i_sat)`` bounds the rates on
-fast ramps: with the Table III gains, Birznieks' 32 N/s ramp drives RAI to
-~1.8 kHz and RAII to one spike per step in 10 ms bins, because the
-Izhikevich rate grows ~2.2 Hz per unit current without bound.  The README
-("Model") records the measured trade-off.
+with one causal 20 Hz low-pass before the derivatives (DDMM-NOTES §1.6).
 
-Derivatives of a raw force signal are useless (DDMM-NOTES §1.6), so F_A is
-low-passed first by a *causal* Butterworth filter and differentiated by
-backward differences.  Both keep explicit state (`FilterState`), so a signal
-cut into chunks gives exactly the currents of the whole signal: streaming and
-offline runs agree bit for bit.  SciPy designs the filter; a small numba
-kernel runs it (direct form II transposed, SciPy's algorithm), because the
-streaming encoder calls it once per millisecond and ``sosfilt``'s ~0.1 ms call
-overhead alone would exceed its latency budget.  Offline and streaming use the
-same kernel, so their arithmetic is identical by construction.
+Every departure from it is a named field of `CurrentParams`, off by default,
+which the physiological presets switch on (README "Physiology"):
+
+* **Per-type filters.**  ``cutoff_sai_hz`` low-passes SA-I's force;
+  ``cutoff_rai_hz`` sets RA-I's low-pass before d/dt (a velocity band-pass,
+  best near 10-60 Hz); ``cutoff_raii_hz`` with ``order_raii`` sets RA-II's
+  low-pass before d^2/dt^2 (acceleration: sensitivity grows as f^2 up to the
+  cut-off and falls beyond it, a Pacinian band-pass near 150-400 Hz).  A
+  scene sampled too slowly to carry RA-II's band is refused (`check_fs`).
+* **Slow adaptation of SA-I.**  ``adapt_sai`` adds ``adapt * (y - slow)``,
+  where ``slow`` is a first-order low-pass of the filtered force with time
+  constant ``tau_adapt_sai_s``: a dynamic loading response that decays
+  through a hold, and silence during unloading (the drive is rectified).
+* **SA-II (Ruffini), a fourth type.**  Driven by skin stretch, from forces
+  the attenuated *shear*: ``x = F_S * (AF - opponent_saii * (1 - AF))`` (so
+  stretch against the preferred direction lowers the rate), low-passed at
+  ``cutoff_saii_hz``, on top of a tonic ``bias_saii`` current.
+* **Saturating transducers.**  ``i_max_<type>`` bounds the current:
+  ``I = i_max * tanh(d / i_max)`` for the linear drive ``d = g * x``, so
+  rates stay physiological on fast ramps.  The older log compression
+  ``i_sat`` (``I = i_sat * log1p(d / i_sat)``, unbounded) is kept.
+* **Receptor noise and current smoothing.**  Drive-proportional noise
+  (``noise_cv``, a population property) multiplies the linear drive before
+  the transducer, ``d (1 + cv * xi / sqrt(h))`` (rectified), so an undriven
+  afferent stays silent and the bound ``i_max`` holds with noise; then
+  ``tau_<type>_s`` low-passes the current (first order).  The Izhikevich
+  neuron with the paper's D = 8 fires its first interval far faster than its
+  steady rate when its current *steps* (I = 100 mV/ms: 1/ISI 1,400 Hz, then
+  230 Hz); a current that rises over ~10 ms keeps the first interval near
+  the steady rate (417 Hz), as real afferents' refractoriness does.
+
+Derivatives of a raw force signal are useless, so F_A is low-passed first by
+a *causal* Butterworth filter and differentiated by backward differences.
+Every stage keeps explicit state (`FilterState`), so a signal cut into chunks
+gives exactly the currents of the whole signal: streaming and offline runs
+agree bit for bit.  SciPy designs the filters; one small numba kernel runs
+them (direct form II transposed, SciPy's ``sosfilt`` arithmetic), because the
+streaming encoder calls it once per millisecond.
 
 Currents are in the Izhikevich model's own units (mV/ms, the units of
 ``dv/dt`` in eq. 4); the gains convert newtons to them.
@@ -32,32 +58,48 @@ from functools import lru_cache
 
 import numba as nb
 import numpy as np
-from scipy import signal
 
 from ._validation import as_finite_array, check_choice, check_positive
 
 __all__ = [
+    "PAPER_TYPES",
     "AFFERENT_TYPES",
     "CurrentParams",
+    "Stage",
     "FilterState",
     "lowpass_sos",
     "initial_filter_state",
     "filter_force",
     "afferent_current",
     "current_core",
+    "check_fs",
 ]
 
-#: The afferent types of the model, in the order used throughout the package.
-AFFERENT_TYPES = ("SAI", "RAI", "RAII")
+#: The paper's three afferent types (eqs 1-3).
+PAPER_TYPES = ("SAI", "RAI", "RAII")
+#: Every afferent type of the package, in the order used throughout: the paper's
+#: three, then SA-II (Ruffini), which the paper leaves out (its §I).
+AFFERENT_TYPES = PAPER_TYPES + ("SAII",)
+#: Derivative order of each type's drive: force, velocity, acceleration, stretch.
+DERIVATIVE_ORDER = {"SAI": 0, "RAI": 1, "RAII": 2, "SAII": 0}
+#: A scene must be sampled at least this many times faster than RA-II's cut-off.
+RAII_FS_FACTOR = 2.5
+
+
+def _optional_positive(obj, names, unit):
+    for name in names:
+        if getattr(obj, name) is not None:
+            check_positive(getattr(obj, name), name, unit)
 
 
 @dataclass(frozen=True)
 class CurrentParams:
-    """Gains and derivative filter of the current stage (eqs 1-3).
+    """Gains, filters and transducers of the current stage.
 
-    The gains are calibrated so that the CMM (AF = 1) press-push-lift response
-    lies near paper Table III (SAI about 47.5 pulses/s, RAI and RAII 10-20);
-    ``experiments/calibrate_core.py`` reproduces the fit.
+    The defaults are the paper's eqs 1-3, with gains calibrated so that the
+    CMM (AF = 1) press-push-lift response lies near paper Table III (SAI
+    about 47.5 pulses/s, RAI and RAII 10-20); ``experiments/calibrate_core.py``
+    reproduces the fit.  Fields marked *ours* are off (None or 0) by default.
 
     Attributes
     ----------
@@ -68,17 +110,43 @@ class CurrentParams:
     g_raii : float
         RAII gain, (mV/ms) per (N/s^2) (eq. 3).
     cutoff_hz : float
-        Cut-off of the causal Butterworth low-pass applied to F_A before
-        differentiation, in Hz (DDMM-NOTES §1.6: 20 Hz restores Table III's
+        Cut-off in Hz of the causal Butterworth low-pass applied to F_A before
+        differentiation (DDMM-NOTES §1.6: 20 Hz restores Table III's
         aligned > misaligned ordering for RAII).
     filter_order : int
         Order of that Butterworth filter (2 in the notes' trial).
     i_sat : float or None
-        Scale of the compressive transducer in mV/ms, for every type:
-        ``I = i_sat * log1p(g * x / i_sat)``, about ``g * x`` while
-        ``g * x << i_sat``.  None: the paper's linear eqs 1-3 verbatim.
+        Scale of the log compression in mV/ms, for every paper type:
+        ``I = i_sat * log1p(g * x / i_sat)``.  None: linear, as eqs 1-3.
     i_sat_sai, i_sat_rai, i_sat_raii : float or None
-        Per-type scales; when given they override ``i_sat`` for that type.
+        Per-type log-compression scales; they override ``i_sat``.
+    cutoff_sai_hz : float or None
+        Ours: low-pass of SA-I's force in Hz (None: unfiltered, eq. 1).
+    cutoff_rai_hz : float or None
+        Ours: RA-I's low-pass before d/dt in Hz (None: ``cutoff_hz``).
+    cutoff_raii_hz : float or None
+        Ours: RA-II's low-pass before d^2/dt^2 in Hz (None: ``cutoff_hz``).
+    order_raii : int or None
+        Ours: order of RA-II's low-pass (None: ``filter_order``).
+    adapt_sai : float
+        Ours: depth of SA-I's slow adaptation (dimensionless, 0: none).
+    tau_adapt_sai_s : float
+        Ours: time constant of that adaptation in s.
+    g_saii : float
+        Ours: SA-II gain, (mV/ms) per N of attenuated shear.
+    bias_saii : float
+        Ours: SA-II's tonic current in mV/ms (its resting discharge).
+    cutoff_saii_hz : float
+        Ours: low-pass of SA-II's stretch drive in Hz.
+    opponent_saii : float
+        Ours: how much stretch against SA-II's preferred direction lowers its
+        drive (dimensionless, 0: attenuated shear only).
+    i_max_sai, i_max_rai, i_max_raii, i_max_saii : float or None
+        Ours: bound of the saturating transducer in mV/ms,
+        ``I = i_max * tanh(d / i_max)``; None: no bound.
+    tau_sai_s, tau_rai_s, tau_raii_s, tau_saii_s : float or None
+        Ours: time constant in s of the first-order low-pass on the current
+        (after the transducer and the receptor noise); None: none.
     """
 
     g_sai: float = 5.367  # fitted: CMM SAI SF 47.5 pulses/s (Table III)
@@ -90,30 +158,138 @@ class CurrentParams:
     i_sat_sai: float | None = None
     i_sat_rai: float | None = None
     i_sat_raii: float | None = None
+    cutoff_sai_hz: float | None = None
+    cutoff_rai_hz: float | None = None
+    cutoff_raii_hz: float | None = None
+    order_raii: int | None = None
+    adapt_sai: float = 0.0
+    tau_adapt_sai_s: float = 1.0
+    g_saii: float = 1.0
+    bias_saii: float = 0.0
+    cutoff_saii_hz: float = 20.0
+    opponent_saii: float = 0.0
+    i_max_sai: float | None = None
+    i_max_rai: float | None = None
+    i_max_raii: float | None = None
+    i_max_saii: float | None = None
+    tau_sai_s: float | None = None
+    tau_rai_s: float | None = None
+    tau_raii_s: float | None = None
+    tau_saii_s: float | None = None
 
     def __post_init__(self):
-        for name in ("g_sai", "g_rai", "g_raii", "cutoff_hz"):
+        for name in ("g_sai", "g_rai", "g_raii", "g_saii", "cutoff_hz", "cutoff_saii_hz", "tau_adapt_sai_s"):
             check_positive(getattr(self, name), name)
-        for name in ("i_sat", "i_sat_sai", "i_sat_rai", "i_sat_raii"):
-            if getattr(self, name) is not None:
-                check_positive(getattr(self, name), name, "mV/ms")
-        if not isinstance(self.filter_order, int) or not 1 <= self.filter_order <= 8:
-            raise ValueError(f"filter_order must be an int in [1, 8], got {self.filter_order!r}")
+        _optional_positive(self, ("i_sat", "i_sat_sai", "i_sat_rai", "i_sat_raii", "i_max_sai", "i_max_rai",
+                                  "i_max_raii", "i_max_saii"), "mV/ms")
+        _optional_positive(self, ("cutoff_sai_hz", "cutoff_rai_hz", "cutoff_raii_hz"), "Hz")
+        _optional_positive(self, ("tau_sai_s", "tau_rai_s", "tau_raii_s", "tau_saii_s"), "s")
+        for name in ("filter_order", "order_raii"):
+            value = getattr(self, name)
+            if value is None and name == "order_raii":
+                continue
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 8:
+                raise ValueError(f"{name} must be an int in [1, 8], got {value!r}")
+        for name in ("adapt_sai", "bias_saii", "opponent_saii"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
+                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
 
     def gain(self, afferent_type: str) -> float:
-        """The gain of ``afferent_type`` (``"SAI"``, ``"RAI"`` or ``"RAII"``)."""
+        """The gain of ``afferent_type`` (``"SAI"``, ``"RAI"``, ``"RAII"`` or ``"SAII"``)."""
         check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
-        return {"SAI": self.g_sai, "RAI": self.g_rai, "RAII": self.g_raii}[afferent_type]
+        return {"SAI": self.g_sai, "RAI": self.g_rai, "RAII": self.g_raii, "SAII": self.g_saii}[afferent_type]
 
     def saturation(self, afferent_type: str) -> float | None:
-        """The transducer scale of ``afferent_type`` in mV/ms (None: linear)."""
-        own = {"SAI": self.i_sat_sai, "RAI": self.i_sat_rai, "RAII": self.i_sat_raii}[afferent_type]
-        return self.i_sat if own is None else own
+        """The log-compression scale of ``afferent_type`` in mV/ms (None: linear)."""
+        own = {"SAI": self.i_sat_sai, "RAI": self.i_sat_rai, "RAII": self.i_sat_raii, "SAII": None}[afferent_type]
+        return self.i_sat if own is None and afferent_type != "SAII" else own
+
+    def stage(self, afferent_type: str) -> "Stage":
+        """The resolved stage of one type: filter, derivative order, transducer."""
+        check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
+        cutoff = {"SAI": self.cutoff_sai_hz, "RAI": self.cutoff_rai_hz or self.cutoff_hz,
+                  "RAII": self.cutoff_raii_hz or self.cutoff_hz, "SAII": self.cutoff_saii_hz}[afferent_type]
+        order = self.order_raii if afferent_type == "RAII" and self.order_raii is not None else self.filter_order
+        i_max = {"SAI": self.i_max_sai, "RAI": self.i_max_rai, "RAII": self.i_max_raii,
+                 "SAII": self.i_max_saii}[afferent_type]
+        tau = {"SAI": self.tau_sai_s, "RAI": self.tau_rai_s, "RAII": self.tau_raii_s,
+               "SAII": self.tau_saii_s}[afferent_type]
+        return Stage(afferent_type, DERIVATIVE_ORDER[afferent_type], cutoff, order,
+                     self.adapt_sai if afferent_type == "SAI" else 0.0, self.tau_adapt_sai_s,
+                     self.gain(afferent_type), self.saturation(afferent_type), i_max,
+                     self.bias_saii if afferent_type == "SAII" else 0.0, tau)
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One type's resolved current stage (see `CurrentParams.stage`).
+
+    Attributes
+    ----------
+    afferent_type : str
+    derivative : int
+        0 (force or stretch), 1 (velocity) or 2 (acceleration).
+    cutoff_hz : float or None
+        Low-pass cut-off in Hz (None: no filter).
+    order : int
+        Low-pass order.
+    adapt, tau_adapt_s : float
+        Slow-adaptation depth (dimensionless) and time constant (s).
+    gain : float
+        Gain from the drive to mV/ms.
+    i_sat, i_max : float or None
+        Log-compression scale and saturation bound, mV/ms.
+    bias : float
+        Tonic current in mV/ms.
+    tau_s : float or None
+        Time constant of the current's low-pass in s.
+    """
+
+    afferent_type: str
+    derivative: int
+    cutoff_hz: float | None
+    order: int
+    adapt: float
+    tau_adapt_s: float
+    gain: float
+    i_sat: float | None
+    i_max: float | None
+    bias: float
+    tau_s: float | None = None
+
+    @property
+    def signed(self) -> bool:
+        """Whether the drive keeps its sign (SA-II's stretch) instead of being rectified."""
+        return self.afferent_type == "SAII"
+
+
+def check_fs(fs: float, params: "CurrentParams", types=AFFERENT_TYPES) -> None:
+    """Refuse a sample rate too slow for a type's filter band.
+
+    RA-II's stage needs ``fs >= 2.5 * cutoff`` (its band must sit well below
+    the Nyquist frequency); every filter needs its cut-off below ``fs / 2``.
+
+    Raises
+    ------
+    ValueError
+        Naming the type, its band and the rate needed.
+    """
+    for kind in types:
+        stage = params.stage(kind)
+        if stage.cutoff_hz is None:
+            continue
+        need = RAII_FS_FACTOR * stage.cutoff_hz if kind == "RAII" else 2.0 * stage.cutoff_hz
+        if fs < need or stage.cutoff_hz >= fs / 2.0:
+            raise ValueError(
+                f"fs={fs:g} Hz is too slow for {kind}: its band reaches {stage.cutoff_hz:g} Hz, which needs force "
+                f"sampled at >= {need:g} Hz; resample the scene faster or leave {kind} out (types=...)"
+            )
 
 
 @dataclass(frozen=True)
 class FilterState:
-    """State of the causal low-pass and backward differences between chunks.
+    """State of a type's causal filter, backward differences and adaptation between chunks.
 
     The filter runs on the deviation from ``offset`` (the first sample), so a
     constant force is filtered exactly and gives exactly zero RAI/RAII current.
@@ -126,12 +302,18 @@ class FilterState:
         Force subtracted before filtering, in newtons.
     y1, y2 : ndarray, shape (n_afferents,)
         The last and second-to-last filtered deviations, in newtons.
+    slow : ndarray, shape (n_afferents,) or None
+        Slow-adaptation low-pass of the filtered deviation (SA-I), in newtons.
+    smooth : ndarray, shape (n_afferents,) or None
+        The current's low-pass state in mV/ms (before the bias).
     """
 
     zi: np.ndarray
     offset: np.ndarray
     y1: np.ndarray
     y2: np.ndarray
+    slow: np.ndarray | None = None
+    smooth: np.ndarray | None = None
 
 
 def lowpass_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
@@ -152,30 +334,47 @@ def lowpass_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
 
 @lru_cache(maxsize=64)
 def _butter_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
+    from scipy import signal  # scipy.signal is slow to import; only filters need it
+
     return signal.butter(order, cutoff_hz, btype="low", fs=fs, output="sos")
 
 
-def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams()) -> FilterState:
+_PASS_THROUGH = np.array([[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]])  # an identity section: no filter
+
+
+def _stage_sos(stage: Stage, fs: float) -> np.ndarray:
+    if stage.cutoff_hz is None:
+        return _PASS_THROUGH
+    if not stage.cutoff_hz < fs / 2.0:
+        lowpass_sos(stage.cutoff_hz, stage.order, fs)  # raises with the Nyquist message
+    return _butter_sos(float(stage.cutoff_hz), int(stage.order), float(fs))
+
+
+def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams(), afferent_type: str = "RAI"
+                         ) -> FilterState:
     """Filter state at rest on a constant input ``f0`` (newtons).
 
     Starting at steady state means a trace that begins mid-contact produces
     no spurious derivative at its first sample; a trace that starts at rest
-    (F_A = 0) is unaffected.
+    (F_A = 0) is unaffected.  ``afferent_type`` selects the stage's filter.
     """
     f0 = np.atleast_1d(np.asarray(f0, dtype=float)).copy()
-    sos = lowpass_sos(params.cutoff_hz, params.filter_order, fs)
+    sos = _stage_sos(params.stage(afferent_type), fs)
     zeros = np.zeros_like(f0)
-    return FilterState(zi=np.zeros((sos.shape[0], 2, f0.size)), offset=f0, y1=zeros, y2=zeros.copy())
+    return FilterState(zi=np.zeros((sos.shape[0], 2, f0.size)), offset=f0, y1=zeros, y2=zeros.copy(),
+                       slow=zeros.copy(), smooth=zeros.copy())
 
 
 @nb.njit(cache=True, nogil=True)
-def _derivative_kernel(sos, f_a, offset, zi, y1, y2, fs, order):
+def _derivative_kernel(sos, f_a, offset, zi, y1, y2, fs, order, slow, adapt, alpha):
     """Filter the deviation from ``offset`` (direct form II transposed, SciPy's
     ``sosfilt`` arithmetic) and return it (order 0) or its backward difference
     ``(y - y1) fs`` (order 1) or ``(y - 2 y1 + y2) fs^2`` (order 2), in one pass.
 
-    ``zi`` (sections, 2, channels), ``y1`` and ``y2`` carry the state and are
-    updated in place.
+    With ``adapt > 0`` (order 0), ``adapt * (y - slow)`` is added, where
+    ``slow`` follows y through a first-order low-pass of coefficient
+    ``alpha``.  ``zi`` (sections, 2, channels), ``y1``, ``y2`` and ``slow``
+    carry the state and are updated in place.
     """
     out = np.empty_like(f_a)
     fs2 = fs * fs
@@ -188,7 +387,11 @@ def _derivative_kernel(sos, f_a, offset, zi, y1, y2, fs, order):
                 zi[s, 1, j] = sos[s, 2] * cur - sos[s, 5] * new
                 cur = new
             if order == 0:
-                out[n, j] = cur
+                if adapt > 0.0:
+                    out[n, j] = cur + adapt * (cur - slow[j])
+                    slow[j] = slow[j] + alpha * (cur - slow[j])
+                else:
+                    out[n, j] = cur
             elif order == 1:
                 out[n, j] = (cur - y1[j]) * fs
             else:
@@ -198,16 +401,19 @@ def _derivative_kernel(sos, f_a, offset, zi, y1, y2, fs, order):
     return out
 
 
-def _run_kernel(f_a, fs, params, state: FilterState, order: int):
+def _run_kernel(f_a, fs, stage: Stage, state: FilterState):
     """`_derivative_kernel` on copies of the state; returns (output, new state)."""
-    sos = _butter_sos(float(params.cutoff_hz), int(params.filter_order), fs)
+    sos = _stage_sos(stage, fs)
     zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
-    out = _derivative_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, float(fs), order)
-    return out, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2)
+    slow = np.zeros_like(y1) if state.slow is None else state.slow.copy()
+    alpha = -np.expm1(-1.0 / (fs * stage.tau_adapt_s))
+    out = _derivative_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, float(fs),
+                             stage.derivative, slow, float(stage.adapt), float(alpha))
+    return out, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2, slow=slow, smooth=state.smooth)
 
 
 def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=None):
-    """Causally low-pass F_A along time (axis 0).
+    """Causally low-pass F_A along time (axis 0) with the shared filter (``cutoff_hz``).
 
     Parameters
     ----------
@@ -229,9 +435,10 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
         State after the last sample.
     """
     f_a = as_finite_array(f_a, "f_a", ndim=2)
+    shared = Stage("RAI", 0, params.cutoff_hz, params.filter_order, 0.0, 1.0, 1.0, None, None, 0.0)
     if state is None:
         state = initial_filter_state(f_a[0], fs, params)
-    dev, new_state = _run_kernel(f_a, fs, params, state, 0)
+    dev, new_state = _run_kernel(f_a, fs, shared, state)
     return dev + state.offset, new_state
 
 
@@ -243,30 +450,32 @@ def afferent_current(
     state: FilterState | None = None,
     scale=None,
 ):
-    """Input current of afferents of one type (eqs 1-3).
+    """Input current of afferents of one type (eqs 1-3, or the type's own stage).
 
     Parameters
     ----------
     f_a : array_like, shape (n_samples, n_afferents)
-        Attenuated force F_A in newtons at sample rate ``fs``.
+        Attenuated force F_A in newtons at sample rate ``fs`` (for SA-II, the
+        signed stretch drive in newtons, see `models.attenuation.stretch_drive`).
     fs : float
         Sample rate in Hz.
-    afferent_type : {"SAI", "RAI", "RAII"}
-        Which of eqs 1-3 to apply.
+    afferent_type : {"SAI", "RAI", "RAII", "SAII"}
+        Which stage to apply.
     params : CurrentParams
-        Gains and derivative filter.
+        Gains, filters and transducers.
     state : FilterState, optional
-        Filter state carried over from a previous chunk (RAI and RAII only).
+        Filter state carried over from a previous chunk.
     scale : array_like, shape (n_afferents,), optional
         Per-afferent multiplier of the drive (gain variability, receptive
-        field weight), applied before the optional compressive transducer.
+        field weight), applied before the transducer.
 
     Returns
     -------
     current : ndarray, shape (n_samples, n_afferents)
-        Rectified current in mV/ms (Izhikevich units), >= 0.
+        Current in mV/ms (Izhikevich units); >= 0 except SA-II's, which
+        stretch against its preferred direction can lower below its bias.
     state : FilterState or None
-        Filter state after the chunk (None for SAI, which needs no filter).
+        Filter state after the chunk (None for the paper's unfiltered SAI).
 
     Examples
     --------
@@ -278,25 +487,67 @@ def afferent_current(
     check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
     fs = check_positive(fs, "fs", "Hz")
     f_a = as_finite_array(f_a, "f_a", ndim=2)
+    check_fs(fs, params, (afferent_type,))
     return current_core(f_a, fs, afferent_type, params, state, scale)
 
 
-def current_core(f_a, fs, afferent_type, params, state=None, scale=None):
-    """`afferent_current` without validation (the streaming encoder's hot path)."""
-    gain = params.gain(afferent_type)
+def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals=None, noise_cv=None):
+    """`afferent_current` without validation (the hot path of `simulate` and the streaming encoder).
+
+    ``normals`` (shape (n_afferents, n_samples), standard normal draws) and
+    ``noise_cv`` (sqrt(ms), per afferent) add the receptor noise of the
+    module docstring; without them the current is noise-free.
+    """
+    stage = params.stage(afferent_type)
+    gain = stage.gain
     if scale is not None:
         gain = gain * np.asarray(scale, dtype=float)
-    i_sat = params.saturation(afferent_type)
-    if afferent_type == "SAI":
-        return _saturate(gain * np.abs(f_a), i_sat), None
+    noisy = normals is not None and noise_cv is not None and np.any(np.asarray(noise_cv) > 0)
+    if stage.derivative == 0 and stage.cutoff_hz is None and stage.adapt == 0.0 and stage.tau_s is None:
+        drive = gain * np.abs(f_a)  # the paper's eq. 1, no filter
+        return _transduce(_receptor_noise(drive, normals, noise_cv, fs) if noisy else drive, stage), None
     if state is None:
-        state = initial_filter_state(f_a[0], fs, params)
-    deriv, new_state = _run_kernel(f_a, fs, params, state, 1 if afferent_type == "RAI" else 2)
-    return _saturate(gain * np.abs(deriv), i_sat), new_state
+        state = initial_filter_state(f_a[0], fs, params, afferent_type)
+    x, new_state = _run_kernel(f_a, fs, stage, state)
+    if stage.derivative == 0:
+        x = x + state.offset
+    if stage.derivative == 0 and stage.adapt > 0.0:
+        x = np.maximum(x, 0.0)  # adaptation undershoots on release: a rate cannot go negative
+    drive = gain * (x if stage.signed else np.abs(x))
+    if noisy:
+        drive = _receptor_noise(drive, normals, noise_cv, fs)
+    current = np.sign(drive) * _transduce(np.abs(drive), stage) if stage.signed else _transduce(drive, stage)
+    if stage.tau_s is not None:
+        smooth = np.zeros(current.shape[1]) if new_state.smooth is None else new_state.smooth.copy()
+        current = _smooth_kernel(np.ascontiguousarray(current), smooth, float(-np.expm1(-1.0 / (fs * stage.tau_s))))
+        new_state = FilterState(new_state.zi, new_state.offset, new_state.y1, new_state.y2, new_state.slow, smooth)
+    if stage.bias != 0.0:
+        current = current + stage.bias
+    return current, new_state
 
 
-def _saturate(drive, i_sat):
-    """Compressive transduction of the linear drive (see the module docstring)."""
-    if i_sat is not None:
-        drive = i_sat * np.log1p(drive / i_sat)
+def _receptor_noise(drive, normals, noise_cv, fs):
+    """``d (1 + cv xi / sqrt(h))``, before the transducer; a rectified drive stays >= 0."""
+    scale = np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs)
+    noisy = drive + drive * (normals.T * scale)
+    return noisy if np.any(drive < 0) else np.maximum(noisy, 0.0)
+
+
+@nb.njit(cache=True, nogil=True)
+def _smooth_kernel(x, c, alpha):
+    """First-order low-pass along axis 0 with state ``c`` (updated in place)."""
+    out = np.empty_like(x)
+    for n in range(x.shape[0]):
+        for j in range(x.shape[1]):
+            c[j] = c[j] + alpha * (x[n, j] - c[j])
+            out[n, j] = c[j]
+    return out
+
+
+def _transduce(drive, stage: Stage):
+    """Log compression and/or saturation of the linear drive (see the module docstring)."""
+    if stage.i_sat is not None:
+        drive = stage.i_sat * np.log1p(drive / stage.i_sat)
+    if stage.i_max is not None:
+        drive = stage.i_max * np.tanh(drive / stage.i_max)
     return drive

@@ -4,9 +4,9 @@ Each step follows the schedule of DDMM-NOTES §3 exactly as Brian2 runs it:
 
 1. the state is updated (forward Euler, Brian2's "rk2" midpoint and "rk4",
    or Izhikevich's 2003 scheme: two half-steps of v, then u from the new v);
-2. v is floored at ``V_FLOOR`` (-100 mV; a no-op for physiological input,
-   it stops strongly negative currents from driving Euler into false
-   spiking at large dt);
+2. v is floored at ``V_FLOOR`` (-100 mV; it stops strongly negative
+   currents from driving Euler into false spiking at large dt, and it binds,
+   changing the trajectory, whenever a negative current reaches it);
 3. threshold ``v >= 30`` on the new v;
 4. reset ``v = c; u = u + d`` and the spike is recorded at the step index.
 

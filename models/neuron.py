@@ -6,9 +6,15 @@
 
 A = 0.02, C = -65, D = 8 for every type.  B = 0.2 for SAI (regular spiking)
 and B = 0.25 for RAI and RAII (low-threshold spiking; the paper's "RAI and
-RAI" is a typo for RAI and RAII, DDMM-NOTES §1.7).  Each neuron starts at
-its resting fixed point for I = 0, not at v = C: an LTS neuron started at
-v = -65, u = B v fires a spurious spike with no input.
+RAI" is a typo for RAI and RAII, DDMM-NOTES §1.7).  SA-II, which the paper
+leaves out, is regular spiking like SA-I (B = 0.2): Ruffini afferents fire
+regularly and adapt slowly.
+
+Each neuron starts at its resting fixed point for I = 0, not at v = C.
+Started elsewhere (e.g. v = -65, u = B v) it relaxes toward rest on the
+recovery time scale 1/A = 50 ms: no spike (none in 1 s at dt = 0.01-1 ms),
+but a transient in v and u that the input did not cause, and that a run of
+zero force should not contain.
 """
 
 from __future__ import annotations
@@ -31,10 +37,14 @@ __all__ = [
 
 #: Spike cut-off in mV (eq. 6).
 V_PEAK = 30.0
-#: Lower bound on v in mV, applied after every step.  The model never gets
-#: there with the package's currents (rest is -70 or -64.4 mV); it stops a
-#: strongly negative user current from driving forward Euler into a false
-#: oscillation (dt > 2/sqrt(0.64 - 0.16 I) ms for B = 0.2) and 1/(2 dt) spiking.
+#: Lower bound on v in mV, applied after every step.  It stops a strongly
+#: negative current from driving forward Euler into a false oscillation
+#: (dt > 2/sqrt(0.64 - 0.16 I) ms for B = 0.2) and 1/(2 dt) spiking.  It is
+#: not a no-op: negative currents do occur (noise dips, SA-II stretch against
+#: its preferred direction, user currents), and where v reaches the floor the
+#: floor changes the trajectory.  Measured on the old preset (additive
+#: 1 mV/sqrt(ms) noise), RA-I reached -107 to -132 mV and RA-II -258 mV, and
+#: the floor changed one RA-II count in 565.
 V_FLOOR = -100.0
 
 
@@ -60,11 +70,12 @@ class NeuronParams:
     d: float = 8.0
 
 
-#: Parameters per type: SAI regular spiking, RAI and RAII low-threshold spiking.
+#: Parameters per type: SAI and SAII regular spiking, RAI and RAII low-threshold spiking.
 NEURON_PARAMS: dict[str, NeuronParams] = {
     "SAI": NeuronParams(b=0.2),
     "RAI": NeuronParams(b=0.25),
     "RAII": NeuronParams(b=0.25),
+    "SAII": NeuronParams(b=0.2),
 }
 
 

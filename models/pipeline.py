@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._validation import check_forces, check_positive
-from .attenuation import F_TH, attenuated_force, attenuation_factor
+from .attenuation import F_TH, attenuated_force, attenuation_factor, profile_factor, stretch_drive
 from .currents import AFFERENT_TYPES, CurrentParams, afferent_current
 from .engines import SpikeResult, integrate
 
@@ -40,14 +40,15 @@ def compute_currents(
     fs : float
         Sample rate of the forces in Hz.
     afferent_type : str or sequence of str
-        ``"SAI"``, ``"RAI"`` or ``"RAII"`` per afferent (or one for all).
+        ``"SAI"``, ``"RAI"``, ``"RAII"`` or ``"SAII"`` per afferent (or one
+        for all).  SA-II is driven by the attenuated shear (skin stretch).
     profile : str
         ``"selective"``, ``"broad"``, ``"bipolar"`` or ``"none"`` (CMM).
     theta_t : float or array_like
         Tuning angle(s) theta_T in degrees.
     k : float or array_like
         Sharpness (eq. 12).
-    no_shear : {"pass", "block"}
+    no_shear : {"pass", "block", "smooth"}
         Reading of eq. 17 when the shear is below F_TH.
     f_th : float
         Shear threshold F_TH in newtons.
@@ -70,19 +71,23 @@ def compute_currents(
     fx, fy, fz = check_forces(fx, fy, fz)
     fs = check_positive(fs, "fs", "Hz")
     theta = np.atleast_1d(np.asarray(theta_t, dtype=float))
-    af = attenuation_factor(fx, fy, theta, profile, k, f_th=f_th, no_shear=no_shear)
-    f_a = attenuated_force(fz, af)
     types = np.broadcast_to(np.asarray(afferent_type, dtype=object), (theta.size,))
     unknown = sorted(set(types) - set(AFFERENT_TYPES), key=str)
     if unknown:
         raise ValueError(
             f"afferent_type={unknown[0]!r} is unknown; allowed: {', '.join(AFFERENT_TYPES)}"
         )
-    current = np.empty_like(f_a)
+    af = attenuation_factor(fx, fy, theta, profile, k, f_th=f_th, no_shear=no_shear)
+    drive = attenuated_force(fz, af)
+    stretch = np.flatnonzero(types == "SAII")
+    if stretch.size:  # SA-II: the attenuated shear (skin stretch), not the normal force
+        raw = profile_factor(fx, fy, theta[stretch], profile, np.broadcast_to(k, theta.shape)[stretch])
+        drive[:, stretch] = stretch_drive(fx, fy, raw, current_params.opponent_saii)
+    current = np.empty_like(drive)
     for kind in AFFERENT_TYPES:
         cols = np.flatnonzero(types == kind)
         if cols.size:
-            current[:, cols], _ = afferent_current(f_a[:, cols], fs, kind, current_params)
+            current[:, cols], _ = afferent_current(drive[:, cols], fs, kind, current_params)
     return current
 
 

@@ -6,7 +6,7 @@ Schema (names are fixed):
   (events) and ``time`` (force samples);
 * coords on ``afferent``: ``afferent`` (the stable afferent id),
   ``afferent_type``, ``theta_t`` (deg), ``nap``, ``k``, ``gain``, ``x_mm``,
-  ``y_mm``, ``noise_sigma``; on ``condition``: ``condition`` (scene name),
+  ``y_mm``, ``noise_sigma``, ``noise_cv``; on ``condition``: ``condition`` (scene name),
   ``duration`` (s), ``theta_r`` (deg) with ``has_theta_r`` (1 when the scene
   has one nominal shear direction); ``time`` (s); ``stage`` (labels of the
   scenes' phases, with ``stage_start``/``stage_end(condition, stage)`` in s);
@@ -21,6 +21,7 @@ Schema (names are fixed):
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from importlib import metadata
 from pathlib import Path
@@ -54,11 +55,11 @@ def model_attrs(population, config) -> dict:
         "seed": config.seed, "no_shear": config.no_shear, "population": population.name,
         "frame": "+X radial, +Y distal; theta 0 radial, 90 distal, 180 ulnar, 270 proximal",
         "f_th": F_TH, "contact_threshold": CONTACT_THRESHOLD, "v_peak": V_PEAK,
-        "current_g_sai": cp.g_sai, "current_g_rai": cp.g_rai, "current_g_raii": cp.g_raii,
-        "current_cutoff_hz": cp.cutoff_hz, "current_filter_order": cp.filter_order,
+        **{f"current_{f.name}": "none" if getattr(cp, f.name) is None else getattr(cp, f.name)
+           for f in dataclasses.fields(cp)},
         **{f"current_i_sat_{t.lower()}": "none" if cp.saturation(t) is None else cp.saturation(t)
            for t in ("SAI", "RAI", "RAII")},
-        "noise_model": "white Gaussian current, sigma/sqrt(h) per sample of h ms",
+        "noise_model": "white Gaussian current, (noise_sigma + noise_cv |I|)/sqrt(h) per sample of h ms",
         "rf_support": RF_SUPPORT,
     }
     for kind, params in NEURON_PARAMS.items():
@@ -81,6 +82,7 @@ def _afferent_coords(population, index) -> dict:
         "x_mm": ("afferent", pop.x_mm[index].astype(float), {"units": "mm"}),
         "y_mm": ("afferent", pop.y_mm[index].astype(float), {"units": "mm"}),
         "noise_sigma": ("afferent", pop.noise_sigma[index].astype(float), {"units": "mV/sqrt(ms)"}),
+        "noise_cv": ("afferent", pop.noise_cv[index].astype(float), {"units": "sqrt(ms)"}),
     }
     return {k: xr.Variable(*v) for k, v in coords.items()}
 

@@ -6,10 +6,16 @@ its designed way to give independent streams (Salmon et al. 2011, the
 Random123 paper; NumPy's `~numpy.random.Philox`).  An afferent's noise is
 therefore the same whichever chunk, worker or subset simulates it.
 
-Noise is white and Gaussian, held for one current sample of length
-h = 1000/fs ms, with standard deviation ``sigma / sqrt(h)`` (mV/ms): the
-voltage noise it causes over any interval is that of a Wiener process of
-intensity sigma (mV/sqrt(ms)), whatever the sample rate or integration step.
+Noise is white and Gaussian, one draw per afferent and current sample of
+length h = 1000/fs ms.  Two terms use it:
+
+* additive, ``sigma * xi / sqrt(h)`` mV/ms: the voltage noise it causes over
+  any interval is that of a Wiener process of intensity sigma
+  (mV/sqrt(ms)), whatever the sample rate or integration step; it acts at
+  rest too;
+* drive-proportional (receptor noise), ``I * cv * xi / sqrt(h)``, applied by
+  the current stage before the current's low-pass: an undriven afferent
+  stays silent.
 """
 
 from __future__ import annotations
@@ -19,7 +25,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-__all__ = ["MAX_AFFERENT_ID", "MAX_TRIALS", "MAX_CONDITIONS", "noise_streams", "draw_noise", "root_seed"]
+__all__ = ["MAX_AFFERENT_ID", "MAX_TRIALS", "MAX_CONDITIONS", "noise_streams", "draw_noise", "noise_current",
+           "root_seed"]
 
 MAX_AFFERENT_ID = 1 << 24
 MAX_TRIALS = 1 << 20
@@ -71,8 +78,8 @@ def _fill(rows, streams):
         gen.standard_normal(out=row)  # releases the GIL while filling
 
 
-def draw_noise(streams, sigma, n_samples: int, fs: float) -> np.ndarray:
-    """The next ``n_samples`` of noise current (mV/ms) per stream, shape (n_samples, n).
+def draw_noise(streams, n_samples: int) -> np.ndarray:
+    """The next ``n_samples`` standard normal draws per stream, shape (n, n_samples).
 
     Streams advance, so consecutive calls continue each afferent's sequence.
     Rows are filled on a small thread pool; each stream is used by one thread.
@@ -80,6 +87,21 @@ def draw_noise(streams, sigma, n_samples: int, fs: float) -> np.ndarray:
     out = np.empty((len(streams), n_samples))
     parts = np.array_split(np.arange(len(streams)), _POOL._max_workers)
     list(_POOL.map(lambda p: _fill(out[p[0]:p[-1] + 1] if p.size else out[:0], streams[p[0]:p[-1] + 1] if p.size else []), parts))
-    scale = np.asarray(sigma, dtype=float) / np.sqrt(1000.0 / fs)
-    out *= scale[:, None]
+    return out
+
+
+def noise_current(normals, sigma, fs: float) -> np.ndarray:
+    """Additive noise current (mV/ms), shape (n_samples, n), from draws of shape (n, n_samples).
+
+    ``sigma * normal / sqrt(h)`` with h = 1000/fs ms.  The drive-proportional
+    term (``noise_cv``) is applied inside the current stage
+    (`models.currents.current_core`), before the current's low-pass; both use
+    the afferent's one draw per sample.
+
+    Examples
+    --------
+    >>> noise_current(np.ones((1, 2)), [2.0], 1000.0).ravel().tolist()
+    [2.0, 2.0]
+    """
+    out = normals * (np.asarray(sigma, dtype=float) / np.sqrt(1000.0 / fs))[:, None]
     return out.T

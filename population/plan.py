@@ -4,12 +4,15 @@
 condition, what can be skipped without changing a single spike:
 
 * the NAP/AF stage when no shear ever exceeds F_TH (AF is then 1 under
-  ``no_shear="pass"`` and 0 under ``"block"``);
+  ``no_shear="pass"`` and 0 under ``"block"``), or, under ``"smooth"`` and
+  for SA-II's stretch, when there is no shear at all;
 * spatial weighting when the scene has no contact geometry;
 * afferent types that were not requested;
-* afferents whose current is provably identically zero (no noise, and zero
-  normal force, zero receptive-field weight, zero gain, or AF = 0): they stay
-  at their resting fixed point and never spike;
+* afferents whose current is provably identically zero (no additive noise,
+  and zero normal force, zero receptive-field weight, zero gain, or AF = 0;
+  for SA-II no bias and no shear): they stay at their resting fixed point
+  and never spike.  Drive-proportional noise (``noise_cv``) is zero with the
+  drive, so it does not stop an afferent from being skipped;
 * noise generation for afferents without noise;
 * recording variables nobody asked for.
 
@@ -30,7 +33,7 @@ from models.currents import AFFERENT_TYPES
 
 from .spatial import receptive_field_weight
 
-__all__ = ["RECORD_CHOICES", "ConditionPlan", "Plan", "make_plan"]
+__all__ = ["RECORD_CHOICES", "ConditionPlan", "Plan", "af_threshold", "make_plan"]
 
 #: Optional dataset variables; spike counts are always recorded.
 RECORD_CHOICES = ("spikes", "forces")
@@ -146,40 +149,54 @@ class Plan:
 def _af_note(cond: ConditionPlan) -> str:
     if cond.af_stage:
         return "computed"
-    return f"skipped (no shear above F_TH = {F_TH} N; AF = {cond.af_constant:g})"
+    return f"skipped (no shear that changes AF; AF = {cond.af_constant:g})"
 
 
-def _unit_keys(pop, sel, cond_af_stage, scale):
+def _unit_keys(pop, sel, tuned, scale):
     """Rows that identify afferents whose currents are bit-identical."""
-    type_code = np.searchsorted(AFFERENT_TYPES, pop.afferent_type[sel]).astype(float)
-    tuned = (pop.nap[sel] != UNTUNED) & cond_af_stage
+    type_code = np.array([AFFERENT_TYPES.index(t) for t in pop.afferent_type[sel]], dtype=float)
     nap_code = np.where(tuned, np.unique(pop.nap, return_inverse=True)[1][sel], -1).astype(float)
     theta = np.where(tuned, pop.theta_t[sel], 0.0)
     k = np.where(tuned, pop.k[sel], 0.0)
     return np.column_stack([type_code, nap_code, theta, k, scale])
 
 
+def af_threshold(no_shear: str) -> float:
+    """Shear (N) above which the AF stage matters: F_TH for eq. 17's readings, 0 for "smooth"."""
+    return 0.0 if no_shear == "smooth" else F_TH
+
+
+def _quiet(pop, sel, scene, scale, af_stage, af_constant):
+    """Afferents whose noise-free current is identically zero (they never leave rest)."""
+    stretch = pop.afferent_type[sel] == "SAII"
+    blocked = (pop.nap[sel] != UNTUNED) & (not af_stage) & (af_constant == 0.0)
+    pressed = (scale == 0.0) | blocked | (not np.any(scene.fz > 0.0))
+    bias = pop.current.bias_saii
+    stretched = (scale == 0.0) | (scene.max_shear() == 0.0)
+    return np.where(stretch, stretched & (bias == 0.0), pressed) & (pop.noise_sigma[sel] == 0.0)
+
+
 def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
     n = sel.size
-    has_shear = scene.max_shear() > F_TH
-    af_stage = has_shear or not enabled
-    af_constant = 1.0 if no_shear == "pass" else 0.0
+    af_stage = scene.max_shear() > af_threshold(no_shear) or not enabled
+    af_constant = 0.0 if no_shear == "block" else 1.0
     weights = None
     if scene.contact is not None or not enabled:
         weights = (np.ones(n) if scene.contact is None else
                    receptive_field_weight(pop.x_mm[sel], pop.y_mm[sel], pop.afferent_type[sel], scene.contact))
     scale = pop.gain[sel] * (1.0 if weights is None else weights)
-    noisy = pop.noise_sigma[sel] > 0
+    noisy = (pop.noise_sigma[sel] > 0) | (pop.noise_cv[sel] > 0)
     if not enabled:
         return ConditionPlan(scene.name, scene.n_samples, True, af_constant, weights,
                              np.empty(0, np.int64), np.full(n, -1, np.int64))
-    blocked = (pop.nap[sel] != UNTUNED) & (not af_stage) & (af_constant == 0.0)
-    quiet = ~noisy & ((scale == 0.0) | blocked | (not np.any(scene.fz > 0.0)))
+    quiet = _quiet(pop, sel, scene, scale, af_stage, af_constant)
     deterministic = np.flatnonzero(~noisy & ~quiet)
-    member = np.where(noisy, -1, -2).astype(np.int64)
+    member = np.where(quiet, -2, -1).astype(np.int64)
     units = np.empty(0, np.int64)
     if deterministic.size:
-        keys = _unit_keys(pop, sel[deterministic], af_stage, scale[deterministic])
+        stretch = pop.afferent_type[sel[deterministic]] == "SAII"
+        tuned = (pop.nap[sel[deterministic]] != UNTUNED) & np.where(stretch, scene.max_shear() > 0.0, af_stage)
+        keys = _unit_keys(pop, sel[deterministic], tuned, scale[deterministic])
         _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
         order = np.argsort(first)  # units in population order, for readable plans
         rank = np.empty_like(order)
@@ -190,7 +207,7 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
 
 
 def make_plan(population, scenes, *, types=None, trials: int = 1, record=RECORD_CHOICES,
-              no_shear: str = "pass", chunk_size: int = 4096, time_chunk: int = 2000,
+              no_shear: str = "smooth", chunk_size: int = 4096, time_chunk: int = 2000,
               enabled: bool = True) -> Plan:
     """Decide what to simulate (see the module docstring).
 
@@ -204,7 +221,7 @@ def make_plan(population, scenes, *, types=None, trials: int = 1, record=RECORD_
         Trials per condition.
     record : sequence of str
         Optional variables to record (``"spikes"``, ``"forces"``).
-    no_shear : {"pass", "block"}
+    no_shear : {"pass", "block", "smooth"}
         Reading of eq. 17.
     chunk_size, time_chunk : int
         Afferents and samples per chunk.

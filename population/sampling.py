@@ -21,7 +21,8 @@ from .spec import NAP_CHOICES, AngleDistribution, PopulationSpec, SharpnessDistr
 
 __all__ = ["Population", "sample_population", "make_population"]
 
-_ARRAYS = ("afferent_type", "theta_t", "nap", "k", "gain", "x_mm", "y_mm", "noise_sigma", "afferent_id")
+_ARRAYS = ("afferent_type", "theta_t", "nap", "k", "gain", "x_mm", "y_mm", "noise_sigma", "noise_cv",
+           "afferent_id")
 
 
 @dataclass(frozen=True, eq=False)
@@ -31,7 +32,7 @@ class Population:
     Attributes
     ----------
     afferent_type : ndarray of str
-        ``"SAI"``, ``"RAI"`` or ``"RAII"``.
+        ``"SAI"``, ``"RAI"``, ``"RAII"`` or ``"SAII"``.
     theta_t : ndarray of float
         Tuning angle in degrees, in [0, 360).
     nap : ndarray of str
@@ -43,7 +44,9 @@ class Population:
     x_mm, y_mm : ndarray of float
         Position on the fingertip in mm (+X radial, +Y distal).
     noise_sigma : ndarray of float
-        Current-noise intensity in mV/sqrt(ms).
+        Additive current-noise intensity in mV/sqrt(ms).
+    noise_cv : ndarray of float
+        Drive-proportional noise intensity in sqrt(ms) (see `TypeSpec`).
     afferent_id : ndarray of int64
         Stable identity; noise streams derive from it.
     current : CurrentParams
@@ -60,6 +63,7 @@ class Population:
     x_mm: np.ndarray
     y_mm: np.ndarray
     noise_sigma: np.ndarray
+    noise_cv: np.ndarray
     afferent_id: np.ndarray
     current: CurrentParams = field(default_factory=CurrentParams)
     name: str = "custom"
@@ -95,12 +99,12 @@ def _validate_values(pop: Population) -> None:
     bad = sorted(set(pop.nap.tolist()) - set(NAP_CHOICES))
     if bad:
         raise ValueError(f"nap={bad[0]!r} is unknown; allowed: {', '.join(NAP_CHOICES)}")
-    for name in ("theta_t", "gain", "x_mm", "y_mm", "noise_sigma", "k"):
+    for name in ("theta_t", "gain", "x_mm", "y_mm", "noise_sigma", "noise_cv", "k"):
         arr = np.asarray(getattr(pop, name), dtype=float)
         if not np.all(np.isfinite(arr)):
             raise ValueError(f"population {name} must be finite")
-    if np.any(pop.gain < 0) or np.any(pop.noise_sigma < 0):
-        raise ValueError("population gain and noise_sigma must be >= 0")
+    if np.any(pop.gain < 0) or np.any(pop.noise_sigma < 0) or np.any(pop.noise_cv < 0):
+        raise ValueError("population gain, noise_sigma and noise_cv must be >= 0")
     for profile in PROFILE_NAMES:
         validate_k(pop.k[pop.nap == profile], profile)
     if len(np.unique(pop.afferent_id)) != len(pop):
@@ -162,6 +166,7 @@ def _sample_type(kind: str, spec: TypeSpec, region, rng) -> dict:
         "afferent_type": np.full(n, kind, dtype=object), "theta_t": _sample_angles(spec.theta_t, n, rng),
         "nap": nap, "k": k, "gain": gain, "x_mm": cx + a * radius * np.cos(angle),
         "y_mm": cy + b * radius * np.sin(angle), "noise_sigma": np.full(n, spec.noise_sigma),
+        "noise_cv": np.full(n, spec.noise_cv),
     }
 
 
@@ -196,7 +201,8 @@ def sample_population(spec, rng=None) -> Population:
 
 
 def make_population(afferent_type, theta_t=0.0, nap=UNTUNED, k=3.0, *, gain=1.0, x_mm=0.0, y_mm=0.0,
-                    noise_sigma=0.0, current: CurrentParams = CurrentParams(), name="custom") -> Population:
+                    noise_sigma=0.0, noise_cv=0.0, current: CurrentParams = CurrentParams(),
+                    name="custom") -> Population:
     """Build a population from explicit per-afferent values (scalars broadcast).
 
     Examples
@@ -211,7 +217,7 @@ def make_population(afferent_type, theta_t=0.0, nap=UNTUNED, k=3.0, *, gain=1.0,
     k = np.where(nap == UNTUNED, 0.0, np.broadcast_to(np.asarray(k, float), (n,)))
     arrays = {name: np.broadcast_to(np.asarray(v, float), (n,)).copy()
               for name, v in (("theta_t", theta_t), ("gain", gain), ("x_mm", x_mm), ("y_mm", y_mm),
-                              ("noise_sigma", noise_sigma))}
+                              ("noise_sigma", noise_sigma), ("noise_cv", noise_cv))}
     return Population(afferent_type=types, nap=np.array(nap), k=k, afferent_id=np.arange(n, dtype=np.int64),
                       current=current, name=name, **arrays)
 

@@ -18,11 +18,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from models._validation import check_choice, check_positive
-from models.attenuation import NO_SHEAR_READINGS, UNTUNED, attenuated_force, attenuation_factor
-from models.currents import afferent_current
+from models.attenuation import (NO_SHEAR_READINGS, UNTUNED, attenuated_force, attenuation_factor, profile_factor,
+                                stretch_drive)
+from models.currents import check_fs, current_core
 from models.engines import ENGINES, METHODS, integrate, prepare, substeps_for
 
-from .noise import draw_noise, noise_streams, root_seed
+from .noise import draw_noise, noise_current, noise_streams, root_seed
 from .plan import RECORD_CHOICES, make_plan
 from .sampling import Population
 from .scenes import Scene
@@ -43,8 +44,8 @@ class SimConfig:
         Integration step in seconds.
     method : str
         Integration scheme.
-    no_shear : {"pass", "block"}
-        Reading of eq. 17.
+    no_shear : {"pass", "block", "smooth"}
+        Reading of eq. 17 ("smooth": the continuous transition, the default).
     seed : int
         Root seed of the noise streams.
     time_chunk : int
@@ -54,7 +55,7 @@ class SimConfig:
     engine: str = "brian2"
     dt: float = 1e-4
     method: str = "euler"
-    no_shear: str = "pass"
+    no_shear: str = "smooth"
     seed: int = 0
     time_chunk: int = 2000
 
@@ -92,22 +93,34 @@ class ChunkJob:
     weights: np.ndarray | None
 
 
-def _runs(values) -> list:
-    """(value, slice) for each run of equal values (blocks are sorted by type and NAP)."""
-    values = np.asarray(values)
-    edges = np.flatnonzero(values[1:] != values[:-1]) + 1
+def _runs(*columns) -> list:
+    """(value, slice) for each run of equal rows (blocks are sorted by type and NAP).
+
+    ``value`` is the first column's value of the run; several columns split
+    runs wherever any of them changes.
+    """
+    values = [np.asarray(c) for c in columns]
+    n = values[0].size
+    if n == 0:
+        return []
+    change = np.zeros(n - 1, bool)
+    for v in values:
+        change |= v[1:] != v[:-1]
+    edges = np.flatnonzero(change) + 1
     starts = np.concatenate([[0], edges])
-    ends = np.concatenate([edges, [values.size]])
-    return [(values[a], slice(int(a), int(b))) for a, b in zip(starts, ends)] if values.size else []
+    ends = np.concatenate([edges, [n]])
+    return [(values[0][a], slice(int(a), int(b))) for a, b in zip(starts, ends)]
 
 
 def _attenuated(job: ChunkJob, sl: slice, no_shear: str) -> np.ndarray:
-    """F_A for the block over samples ``sl`` (newtons)."""
+    """Each afferent's drive over samples ``sl`` in newtons: F_A, or SA-II's stretch."""
     pop, scene = job.population, job.scene
     fz = scene.fz[sl]
     f_a = np.empty((fz.size, len(pop)))
-    for profile, cols in _runs(pop.nap):
-        if profile == UNTUNED:
+    for profile, cols in _runs(pop.nap, pop.afferent_type):
+        if pop.afferent_type[cols.start] == "SAII":
+            f_a[:, cols] = _stretch(scene, sl, pop, cols, profile)
+        elif profile == UNTUNED:
             f_a[:, cols] = fz[:, None]
         elif not job.af_stage:
             f_a[:, cols] = job.af_constant * fz[:, None]
@@ -118,12 +131,25 @@ def _attenuated(job: ChunkJob, sl: slice, no_shear: str) -> np.ndarray:
     return f_a
 
 
-def _currents(job: ChunkJob, f_a, states: dict, scale) -> np.ndarray:
-    pop = job.population
+def _stretch(scene, sl, pop, cols, profile):
+    """SA-II's signed stretch drive (the attenuated shear), zero without shear."""
+    fx, fy = scene.fx[sl], scene.fy[sl]
+    if scene.max_shear() == 0.0:
+        return np.zeros((fx.size, cols.stop - cols.start))
+    af = profile_factor(fx, fy, pop.theta_t[cols], profile, pop.k[cols]) if profile != UNTUNED else 1.0
+    return stretch_drive(fx, fy, np.broadcast_to(af, (fx.size, cols.stop - cols.start)), pop.current.opponent_saii)
+
+
+def _currents(job: ChunkJob, f_a, states: dict, scale, normals=None) -> np.ndarray:
+    """Currents (mV/ms) of the block, with receptor noise when ``normals`` are given."""
+    pop, fs = job.population, job.scene.fs
     current = np.empty_like(f_a)
     for i, (kind, cols) in enumerate(_runs(pop.afferent_type)):
-        current[:, cols], states[i] = afferent_current(
-            f_a[:, cols], job.scene.fs, kind, pop.current, states.get(i), scale=scale[cols])
+        current[:, cols], states[i] = current_core(
+            f_a[:, cols], fs, kind, pop.current, states.get(i), scale[cols],
+            None if normals is None else normals[cols], pop.noise_cv[cols])
+    if normals is not None and np.any(pop.noise_sigma > 0):
+        current += noise_current(normals, pop.noise_sigma, fs)
     return current
 
 
@@ -135,9 +161,8 @@ def _run_trial(job: ChunkJob, trial: int, config: SimConfig, progress=None):
     filters, neuron, afferents, steps = {}, None, [], []
     for start in range(0, scene.n_samples, config.time_chunk):
         sl = slice(start, min(scene.n_samples, start + config.time_chunk))
-        current = _currents(job, _attenuated(job, sl, config.no_shear), filters, scale)
-        if streams is not None:
-            current += draw_noise(streams, pop.noise_sigma, current.shape[0], scene.fs)
+        normals = None if streams is None else draw_noise(streams, sl.stop - sl.start)
+        current = _currents(job, _attenuated(job, sl, config.no_shear), filters, scale, normals)
         res = integrate(current, fs=scene.fs, dt=config.dt, afferent_type=pop.afferent_type,
                         engine=config.engine, method=config.method, state=neuron)
         neuron = res.state
@@ -148,7 +173,7 @@ def _run_trial(job: ChunkJob, trial: int, config: SimConfig, progress=None):
     return np.concatenate(afferents), np.concatenate(steps)
 
 
-def population_currents(population, scene, *, no_shear: str = "pass") -> np.ndarray:
+def population_currents(population, scene, *, no_shear: str = "smooth") -> np.ndarray:
     """Noise-free input currents (mV/ms) of every afferent, shape (n_samples, n_afferents).
 
     The same computation `simulate` runs (AF, receptive fields, gains, filter),
@@ -162,7 +187,7 @@ def population_currents(population, scene, *, no_shear: str = "pass") -> np.ndar
         weights = receptive_field_weight(population.x_mm, population.y_mm, population.afferent_type, scene.contact)
     scale = population.gain if weights is None else population.gain * weights
     order = _grouped(population, np.arange(len(population)), np.arange(len(population)))
-    job = ChunkJob(scene, population.select(order), 0, (0,), False, True, 1.0 if no_shear == "pass" else 0.0,
+    job = ChunkJob(scene, population.select(order), 0, (0,), False, True, 0.0 if no_shear == "block" else 1.0,
                    None if weights is None else weights[order])
     current = _currents(job, _attenuated(job, slice(None), no_shear), {}, scale[order])
     out = np.empty_like(current)
@@ -202,7 +227,7 @@ def _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_si
     return scenes
 
 
-def plan_run(population, scenes, *, trials=1, record=RECORD_CHOICES, no_shear="pass", types=None,
+def plan_run(population, scenes, *, trials=1, record=RECORD_CHOICES, no_shear="smooth", types=None,
              chunk_size=4096, time_chunk=2000, plan=True):
     """The `Plan` that `simulate` would follow (print it with ``plan.describe``)."""
     scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
@@ -267,7 +292,7 @@ def _expand(cond, members, the_plan, block, deterministic, result):
 
 
 def simulate(population, scenes, *, engine="brian2", dt=None, method=None, tolerance=None, trials=1, seed=None,
-             record=RECORD_CHOICES, no_shear="pass", types=None, plan=True, chunk_size=4096,
+             record=RECORD_CHOICES, no_shear="smooth", types=None, plan=True, chunk_size=4096,
              time_chunk=2000, scheduler=None, quiet=False):
     """Simulate a population on one or more scenes.
 
@@ -293,8 +318,9 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
         Root of every noise stream; recorded in the dataset's attrs.
     record : sequence of str
         Optional variables: ``"spikes"`` (events) and ``"forces"``.
-    no_shear : {"pass", "block"}
-        Reading of eq. 17.
+    no_shear : {"pass", "block", "smooth"}
+        Reading of eq. 17: the continuous transition ("smooth", default), or
+        the paper's two (`models.attenuation`).
     types : sequence of str, optional
         Afferent types to simulate (default: all).
     plan : bool
@@ -331,6 +357,7 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
     config = SimConfig(engine, float(dt), method, no_shear, root_seed(seed), int(time_chunk))
     the_plan = plan_run(population, scenes, trials=trials, record=record, no_shear=no_shear, types=types,
                         chunk_size=chunk_size, time_chunk=time_chunk, plan=plan)
+    check_fs(scenes[0].fs, population.current, tuple(np.unique(population.afferent_type[the_plan.selected])))
     spikes = [[] for _ in scenes]
     members = [_unit_members(cond) for cond in the_plan.conditions]
     work = list(_jobs(population, scenes, the_plan))

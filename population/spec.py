@@ -19,7 +19,8 @@ TOML layout (every table optional unless marked)::
     g_sai = 5.367
     [types.SAI]                    # one table per type present
     count = 282                    # or density_per_cm2 = 70.0
-    noise_sigma = 1.0              # mV/sqrt(ms)
+    noise_sigma = 1.0              # mV/sqrt(ms), additive
+    noise_cv = 0.3                 # sqrt(ms), proportional to the drive
     gain_cv = 0.2                  # per-afferent gain spread (lognormal CV)
     theta_t = { distribution = "von_mises", mean_deg = 90.0, kappa = 0.6 }
     nap = { selective = 0.4, broad = 0.3, bipolar = 0.1, none = 0.2 }
@@ -204,9 +205,16 @@ class TypeSpec:
     gain_cv : float
         Coefficient of variation of the per-afferent gain (lognormal, mean 1).
     noise_sigma : float
-        White current-noise intensity in mV/sqrt(ms): each current sample of
-        length h ms gets ``noise_sigma * N(0, 1) / sqrt(h)``, so the voltage
-        noise over any interval is independent of the sampling.
+        Additive white current-noise intensity in mV/sqrt(ms): each current
+        sample of length h ms gets ``noise_sigma * N(0, 1) / sqrt(h)``, so the
+        voltage noise over any interval is independent of the sampling.  It
+        acts at rest too: on low-threshold (RA) neurons it causes firing
+        without any force.
+    noise_cv : float
+        Drive-proportional (receptor) noise intensity in sqrt(ms): a sample
+        of current I gets ``noise_cv * |I| * N(0, 1) / sqrt(h)`` more, so an
+        afferent with no drive stays silent while a driven one varies from
+        trial to trial.  At 1 kHz (h = 1 ms) its SD is ``noise_cv * |I|``.
     """
 
     count: int | None = None
@@ -216,6 +224,7 @@ class TypeSpec:
     sharpness: dict = field(default_factory=lambda: dict(DEFAULT_SHARPNESS))
     gain_cv: float = 0.0
     noise_sigma: float = 0.0
+    noise_cv: float = 0.0
 
     def __post_init__(self):
         if (self.count is None) == (self.density_per_cm2 is None):
@@ -238,6 +247,7 @@ class TypeSpec:
         object.__setattr__(self, "sharpness", sharp)
         _finite("gain_cv", self.gain_cv, nonneg=True)
         _finite("noise_sigma", self.noise_sigma, nonneg=True)
+        _finite("noise_cv", self.noise_cv, nonneg=True)
 
     def n_afferents(self, region: Region) -> int:
         """Count, or density times the region's area, rounded."""
@@ -255,7 +265,7 @@ class PopulationSpec:
     name : str
         Label stored in datasets.
     types : dict
-        `TypeSpec` per afferent type (``"SAI"``, ``"RAI"``, ``"RAII"``).
+        `TypeSpec` per afferent type (``"SAI"``, ``"RAI"``, ``"RAII"``, ``"SAII"``).
     region : Region
         Where afferents are placed (uniformly), in mm.
     current : CurrentParams

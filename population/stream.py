@@ -21,15 +21,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from models._validation import as_finite_array, check_choice, check_positive
-from models.attenuation import F_TH, NO_SHEAR_READINGS, UNTUNED, _af_kernel
-from models.currents import current_core
+from models.attenuation import F_TH, NO_SHEAR_READINGS, UNTUNED, _af_kernel, blend_no_shear, stretch_drive
+from models.currents import check_fs, current_core
 from models.direct import _BLOCK, _METHOD_CODES, _integrate_range
 from models.engines import (ENGINES, METHODS, NeuronState, check_integration, check_stability, integrate, prepare,
                             substeps_for)
 from models.nap import get_profile, tip_radius
 from models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
 
-from .noise import draw_noise, noise_streams, root_seed
+from .noise import draw_noise, noise_current, noise_streams, root_seed
 from .sampling import Population
 from .scenes import Contact
 from .simulate import _grouped, _runs
@@ -72,8 +72,8 @@ class Encoder:
         Integration scheme.
     seed : int, Generator or None
         Root of the noise streams (as in `simulate`).
-    no_shear : {"pass", "block"}
-        Reading of eq. 17.
+    no_shear : {"pass", "block", "smooth"}
+        Reading of eq. 17 (default "smooth", as `simulate`).
     contact : Contact, optional
         Fixed contact geometry, for receptive-field weighting.
     noise_block : int
@@ -89,7 +89,7 @@ class Encoder:
     """
 
     def __init__(self, population, fs: float, *, dt: float = 1e-4, engine: str = "direct", method: str = "euler",
-                 seed=None, no_shear: str = "pass", contact: Contact | None = None, noise_block: int = 1000):
+                 seed=None, no_shear: str = "smooth", contact: Contact | None = None, noise_block: int = 1000):
         if not isinstance(population, Population):
             raise TypeError(f"population must be a Population, got {type(population).__name__}")
         self.fs = check_positive(fs, "fs", "Hz")
@@ -100,6 +100,7 @@ class Encoder:
         if contact is not None and not isinstance(contact, Contact):
             raise TypeError(f"contact must be a Contact or None, got {type(contact).__name__}")
         self.seed, self.contact, self.noise_block = root_seed(seed), contact, int(noise_block)
+        check_fs(self.fs, population.current, tuple(np.unique(population.afferent_type)))
         idx = np.arange(len(population))
         self._order = _grouped(population, idx, idx)  # contiguous (type, NAP) groups, as offline
         self._pop = population.select(self._order)
@@ -127,6 +128,11 @@ class Encoder:
             weights = receptive_field_weight(pop.x_mm, pop.y_mm, pop.afferent_type, self.contact)
         self._scale = pop.gain if weights is None else pop.gain * weights
         self._groups = [(kind, cols) for kind, cols in _runs(pop.afferent_type)]
+        stretch = pop.afferent_type == "SAII"
+        self._press_untuned = np.flatnonzero(~stretch & (pop.nap == UNTUNED))
+        self._press_tuned = np.flatnonzero(~stretch[self._tuned])  # positions within the tuned afferents
+        self._stretch = np.flatnonzero(stretch)
+        self._stretch_tuned = stretch[self._tuned]  # which tuned afferents are SA-II
         self._neuron_params = neuron_arrays(pop.afferent_type)
         self._h, self._half = 1.0 * self.dt / 0.001, (1.0 * (0.5 * self.dt)) / 0.001  # as run_direct computes them
 
@@ -185,7 +191,7 @@ class Encoder:
 
     def _prefetch(self, rows: int) -> None:
         """Start drawing the next ``rows`` noise samples on the background thread (one draw at a time)."""
-        self._pending = _PREFETCH.submit(draw_noise, self._streams, self._pop.noise_sigma, rows, self.fs)
+        self._pending = _PREFETCH.submit(lambda: draw_noise(self._streams, rows).T)
 
     def _validate(self, forces, times):
         forces = as_finite_array(forces, "forces")
@@ -224,9 +230,8 @@ class Encoder:
         if n == 0:
             return StreamSpikes(np.empty(0, np.int64), np.empty(0))
         filters = dict(self._filters)  # committed only if the whole chunk succeeds
-        current = self._currents(forces, filters)
-        if self._streams is not None:
-            current += self._peek_noise(n)
+        normals = None if self._streams is None else self._peek_noise(n).T
+        current = self._currents(forces, filters, normals)
         afferent, step, v, u = self._integrate(current)
         step0 = self._samples * self.substeps
         self._filters, self._neuron = filters, NeuronState(v, u)
@@ -241,23 +246,37 @@ class Encoder:
             afferent, step = afferent[order], step[order]
         return StreamSpikes(afferent, step * self.dt)
 
-    def _currents(self, forces, filters) -> np.ndarray:
+    def _currents(self, forces, filters, normals=None) -> np.ndarray:
         """Currents of a chunk: the offline arithmetic (`af_core`, `current_core`) without its checks."""
         fx, fy, fz = forces[:, 0], forces[:, 1], forces[:, 2]
         n, n_aff = forces.shape[0], len(self._pop)
-        af = np.ones((n, n_aff))
-        if self._tuned.size:
-            mag = np.hypot(fx, fy)
-            active = mag > F_TH
-            af[:, self._tuned] = 1.0 if self.no_shear == "pass" else 0.0
-            if active.any():
-                ux, uy = fx[active] / mag[active], fy[active] / mag[active]
-                af[np.ix_(active, self._tuned)] = _af_kernel(ux, uy, *self._af_args)  # af_core's kernel
-        f_a = af * fz[:, None]
-        current = np.empty_like(f_a)
+        drive = np.empty((n, n_aff))
+        drive[:, self._press_untuned] = fz[:, None]
+        mag = np.hypot(fx, fy)
+        profile = np.ones((n, self._tuned.size))
+        sheared = mag > 0.0
+        if self._tuned.size and sheared.any():
+            ux, uy = fx[sheared] / mag[sheared], fy[sheared] / mag[sheared]
+            profile[sheared] = _af_kernel(ux, uy, *self._af_args)  # af_core's kernel
+        press = profile[:, self._press_tuned]
+        if self.no_shear == "smooth":
+            af = blend_no_shear(press, mag, F_TH)
+        else:
+            af = np.where((mag > F_TH)[:, None], press, 1.0 if self.no_shear == "pass" else 0.0)
+        drive[:, self._tuned[self._press_tuned]] = af * fz[:, None]
+        if self._stretch.size:
+            af_stretch = np.ones((n, self._stretch.size))
+            tuned_cols = np.flatnonzero(self._pop.nap[self._stretch] != UNTUNED)
+            af_stretch[:, tuned_cols] = profile[:, self._stretch_tuned]
+            drive[:, self._stretch] = stretch_drive(fx, fy, af_stretch, self._pop.current.opponent_saii)
+        current = np.empty_like(drive)
+        pop = self._pop
         for i, (kind, cols) in enumerate(self._groups):
-            current[:, cols], filters[i] = current_core(f_a[:, cols], self.fs, kind, self._pop.current,
-                                                        filters.get(i), self._scale[cols])
+            current[:, cols], filters[i] = current_core(drive[:, cols], self.fs, kind, pop.current, filters.get(i),
+                                                        self._scale[cols], None if normals is None else normals[cols],
+                                                        pop.noise_cv[cols])
+        if normals is not None and np.any(pop.noise_sigma > 0):
+            current += noise_current(normals, pop.noise_sigma, self.fs)
         return current
 
     def _integrate(self, current):

@@ -33,6 +33,7 @@ import numpy as np
 import xarray as xr
 from scipy import stats
 
+from models.currents import AFFERENT_TYPES
 from models.metrics import direction_index
 
 from .scenes import birznieks
@@ -151,7 +152,7 @@ def tuning_summary(tuning: xr.Dataset) -> dict:
     resp = tuning.responsive.values == 1
     types = tuning.afferent_type.values
     fractions, dsi, counts = {}, {}, {}
-    for kind in ("SAI", "RAI", "RAII"):
+    for kind in AFFERENT_TYPES:
         sel = resp & (types == kind)
         counts[kind] = int(sel.sum())
         if not sel.any():

@@ -94,7 +94,7 @@ def test_bad_rates_and_types():
     with pytest.raises(ValueError, match="Nyquist"):
         lowpass_sos(20.0, 2, 30.0)
     with pytest.raises(ValueError, match="afferent_type"):
-        afferent_current(np.zeros((3, 1)), FS, "SAII")
+        afferent_current(np.zeros((3, 1)), FS, "SAIII")
     with pytest.raises(ValueError, match="f_a"):
         afferent_current(np.array([[np.nan]]), FS, "SAI")
 

@@ -86,7 +86,7 @@ def test_substeps_must_be_whole():
     (dict(engine="neuron"), ValueError, "engine"),
     (dict(method="rk9"), ValueError, "method"),
     (dict(method="rk45"), ValueError, "method"),
-    (dict(afferent_type="SAII"), ValueError, "afferent_type"),
+    (dict(afferent_type="SAIII"), ValueError, "afferent_type"),
     (dict(state=(1, 2)), TypeError, "state"),
     (dict(state=NeuronState(np.zeros(2), np.zeros(2))), ValueError, "state"),
 ])

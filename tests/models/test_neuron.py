@@ -26,4 +26,4 @@ def test_neuron_arrays_and_bad_type():
     arr = neuron_arrays(["RAII", "SAI"])
     np.testing.assert_array_equal(arr["b"], [0.25, 0.2])
     with pytest.raises(ValueError, match="afferent_type"):
-        neuron_arrays(["SAII"])
+        neuron_arrays(["SAIII"])

@@ -61,7 +61,7 @@ def test_select_keeps_ids_and_make_population_validates():
     with pytest.raises(ValueError, match="k="):
         make_population(["SAI"], nap="broad", k=1.0)
     with pytest.raises(ValueError, match="afferent_type"):
-        make_population(["SAII"])
+        make_population(["SAIII"])
 
 
 def test_sampling_does_not_depend_on_the_hash_seed():

@@ -131,7 +131,7 @@ def test_spatial_weighting_silences_far_afferents():
 @pytest.mark.parametrize("kwargs,exc,match", [
     (dict(dt=0.0), ValueError, "dt"), (dict(dt=3e-4), ValueError, "dt"), (dict(engine="nest"), ValueError, "engine"),
     (dict(trials=0), ValueError, "trials"), (dict(no_shear="x"), ValueError, "no_shear"),
-    (dict(types=("SAII",)), ValueError, "types"), (dict(record=("voltage",)), ValueError, "record"),
+    (dict(types=("SAIII",)), ValueError, "types"), (dict(record=("voltage",)), ValueError, "record"),
     (dict(seed=-1), TypeError, "seed"), (dict(chunk_size=0), ValueError, "chunk_size"),
 ])
 def test_bad_arguments(small, kwargs, exc, match):

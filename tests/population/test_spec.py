@@ -32,7 +32,7 @@ BAD = [
     ({"types": {"SAI": {"count": 3, "nap": {"selective": 0.5, "none": 0.4}}}}, "sum to 1"),
     ({"types": {"SAI": {"count": 3, "theta_t": {"distribution": "cauchy"}}}}, "cauchy"),
     ({"types": {"SAI": {"count": 3, "sharpness": {"broad": {"distribution": "gamma"}}}}}, "gamma"),
-    ({"types": {"SAII": {"count": 3}}}, "SAII"),
+    ({"types": {"SAIII": {"count": 3}}}, "SAIII"),
     ({"types": {"SAI": {"count": 3, "nap": {"round": 1.0}}}}, "round"),
     ({"types": {"SAI": {"count": 3, "density_per_cm2": 5.0}}}, "exactly one"),
     ({"types": {}}, "types"),
