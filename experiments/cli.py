@@ -17,7 +17,7 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand registered."""
-    from . import bench, cmd_accuracy, cmd_biology, cmd_population, cmd_reproduce, cmd_stream
+    from . import bench, cmd_accuracy, cmd_biology, cmd_physiology, cmd_population, cmd_reproduce, cmd_stream
 
     parser = _Parser(
         prog="ddmm",
@@ -25,7 +25,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                 parser_class=_Parser)
-    for module in (cmd_reproduce, cmd_population, cmd_biology, cmd_accuracy, cmd_stream, bench):
+    for module in (cmd_reproduce, cmd_population, cmd_biology, cmd_physiology, cmd_accuracy, cmd_stream, bench):
         module.register(sub)
     return parser
 

@@ -14,11 +14,15 @@ from .reference import HUMAN_DIRECTION_THRESHOLD_DEG, HUMAN_DSI, HUMAN_TUNED_FRA
 __all__ = ["register", "TUNING_REFERENCE", "run_tuning_stats", "decode_summary"]
 
 TUNING_REFERENCE = {
-    "tuned_fraction": {"all": HUMAN_TUNED_FRACTION["all"], "SAI": HUMAN_TUNED_FRACTION["SAI"],
-                       "RAI": HUMAN_TUNED_FRACTION["RAI"], "RAII": "not reported"},
+    "tuned_fraction": {"recorded": HUMAN_TUNED_FRACTION["all"], "SAI": HUMAN_TUNED_FRACTION["SAI"],
+                       "RAI": HUMAN_TUNED_FRACTION["RAI"], "RAII": "not reported", "SAII": "not reported",
+                       "all": "not comparable (includes FA-II, which the 86% does not)"},
     "dsi": {"SAI": {"mean": HUMAN_DSI["SAI"][0], "sd": HUMAN_DSI["SAI"][1]},
-            "RAI": {"mean": HUMAN_DSI["RAI"][0], "sd": HUMAN_DSI["RAI"][1]}, "RAII": "not reported"},
-    "source": "Birznieks et al. 2001, as the DDMM paper reports it",
+            "RAI": {"mean": HUMAN_DSI["RAI"][0], "sd": HUMAN_DSI["RAI"][1]}, "RAII": "not reported",
+            "SAII": "not reported"},
+    "source": "Birznieks et al. 2001, as the DDMM paper reports it; the 86% pools SA-I, SA-II and FA-I",
+    "roles": {"SAI": "fitted", "RAI": "fitted", "SAII": "prediction", "RAII": "prediction",
+              "recorded": "count-weighted mix of the fitted SA-I and FA-I fractions and the SA-II prediction"},
 }
 
 
@@ -33,8 +37,8 @@ def register(sub) -> None:
     p.add_argument("--out", metavar="DIR")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=run_tuning)
-    p = sub.add_parser("calibrate", help="fit the fingertip preset's free parameters to human tuning data")
-    p.add_argument("--out", metavar="DIR", help="write calibrate.json and calibrated_fingertip.toml here")
+    p = sub.add_parser("calibrate", help="refit both presets to human tuning data under the rate constraints")
+    p.add_argument("--out", metavar="DIR", help="write calibrate.json and calibrated_{fingertip,hand}.toml here")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=run_calibrate)
     p = sub.add_parser("decode", help="decode shear direction from population spikes (vs 7.1 deg)")
@@ -74,7 +78,7 @@ def run_tuning(args) -> int:
     else:
         print(f"# direction tuning: {args.population}, seed {args.seed}, {result['test']}\n")
         print("| type | tuned (model) | tuned (human) | DSI model mean ± SD | DSI human |\n|---|---|---|---|---|")
-        for kind in ("SAI", "RAI", "RAII", "all"):
+        for kind in ("SAI", "RAI", "RAII", "SAII", "recorded", "all"):
             ref_f = TUNING_REFERENCE["tuned_fraction"][kind]
             d = summary["dsi"].get(kind)
             ref_d = TUNING_REFERENCE["dsi"].get(kind, "")
@@ -91,19 +95,21 @@ def run_tuning(args) -> int:
 
 
 def run_calibrate(args) -> int:
-    from .calibrate import calibrate, spec_to_toml
+    from .calibrate import adopt, calibrate, spec_to_toml
 
     out_dir = ensure_out_dir(args.out) if args.out else None
     spec, report = calibrate()
     if args.json:
         print(json.dumps(report))
     else:
-        print(json.dumps({"fits": report["fits"], "validation_mean_sd": report["validation"]["mean_sd"]}, indent=1))
+        print(json.dumps({"fits": report["fits"], "validation_mean_sd": report["validation"]["mean_sd"],
+                          "scorecard": report["validation"]["scorecard_all_pass"]}, indent=1))
     if out_dir is not None:
         save_json(report, out_dir / "calibrate.json")
         header = "# Written by `ddmm calibrate`; copy into population/presets/ to adopt.\n"
-        text = spec_to_toml(spec, header)
-        atomic_write(out_dir / "calibrated_fingertip.toml", lambda tmp: Path(tmp).write_text(text))
+        for name, fitted in (("fingertip", spec), ("hand", adopt(spec, "hand"))):
+            text = spec_to_toml(fitted, header)
+            atomic_write(out_dir / f"calibrated_{name}.toml", lambda tmp, text=text: Path(tmp).write_text(text))
     return 0
 
 

@@ -13,7 +13,7 @@ from models.currents import AFFERENT_TYPES
 __all__ = ["plot_response", "plot_sf_vs_theta", "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces",
            "plot_dsi_histograms", "plot_preferred_rose", "plot_neurometric", "plot_pareto"]
 
-_TYPE_COLOURS = {"SAI": "tab:blue", "RAI": "tab:orange", "RAII": "tab:green"}
+_TYPE_COLOURS = {"SAI": "tab:blue", "RAI": "tab:orange", "RAII": "tab:green", "SAII": "tab:purple"}
 
 
 def _plot_forces(ax, time, forces):

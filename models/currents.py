@@ -17,6 +17,8 @@ which the physiological presets switch on (README "Physiology"):
   low-pass before d^2/dt^2 (acceleration: sensitivity grows as f^2 up to the
   cut-off and falls beyond it, a Pacinian band-pass near 150-400 Hz).  A
   scene sampled too slowly to carry RA-II's band is refused (`check_fs`).
+* **Adaptation.**  ``adapt_rai`` makes RA-I adapt to a sustained velocity
+  (the rectified velocity minus a low-pass of itself).
 * **Slow adaptation of SA-I.**  ``adapt_sai`` adds ``adapt * (y - slow)``,
   where ``slow`` is a first-order low-pass of the filtered force with time
   constant ``tau_adapt_sai_s``: a dynamic loading response that decays
@@ -132,6 +134,16 @@ class CurrentParams:
         Ours: depth of SA-I's slow adaptation (dimensionless, 0: none).
     tau_adapt_sai_s : float
         Ours: time constant of that adaptation in s.
+    adapt_rai : float
+        Ours: depth of RA-I's adaptation to a sustained velocity
+        (dimensionless, 0: none): the rectified velocity minus ``adapt_rai``
+        times its first-order low-pass, floored at 0.  RA-I afferents signal
+        changes; a slow ramp excites them only at its start.
+    tau_adapt_rai_s : float
+        Ours: time constant of that adaptation in s.
+    threshold_rai : float
+        Ours: RA-I's velocity threshold in N/s, subtracted from the adapted
+        rectified velocity (a dead zone: slow changes do not excite).
     g_saii : float
         Ours: SA-II gain, (mV/ms) per N of attenuated shear.
     bias_saii : float
@@ -164,6 +176,9 @@ class CurrentParams:
     order_raii: int | None = None
     adapt_sai: float = 0.0
     tau_adapt_sai_s: float = 1.0
+    adapt_rai: float = 0.0
+    tau_adapt_rai_s: float = 0.1
+    threshold_rai: float = 0.0
     g_saii: float = 1.0
     bias_saii: float = 0.0
     cutoff_saii_hz: float = 20.0
@@ -178,7 +193,8 @@ class CurrentParams:
     tau_saii_s: float | None = None
 
     def __post_init__(self):
-        for name in ("g_sai", "g_rai", "g_raii", "g_saii", "cutoff_hz", "cutoff_saii_hz", "tau_adapt_sai_s"):
+        for name in ("g_sai", "g_rai", "g_raii", "g_saii", "cutoff_hz", "cutoff_saii_hz", "tau_adapt_sai_s",
+                     "tau_adapt_rai_s"):
             check_positive(getattr(self, name), name)
         _optional_positive(self, ("i_sat", "i_sat_sai", "i_sat_rai", "i_sat_raii", "i_max_sai", "i_max_rai",
                                   "i_max_raii", "i_max_saii"), "mV/ms")
@@ -190,7 +206,7 @@ class CurrentParams:
                 continue
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 8:
                 raise ValueError(f"{name} must be an int in [1, 8], got {value!r}")
-        for name in ("adapt_sai", "bias_saii", "opponent_saii"):
+        for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -216,9 +232,11 @@ class CurrentParams:
         tau = {"SAI": self.tau_sai_s, "RAI": self.tau_rai_s, "RAII": self.tau_raii_s,
                "SAII": self.tau_saii_s}[afferent_type]
         return Stage(afferent_type, DERIVATIVE_ORDER[afferent_type], cutoff, order,
-                     self.adapt_sai if afferent_type == "SAI" else 0.0, self.tau_adapt_sai_s,
+                     {"SAI": self.adapt_sai, "RAI": self.adapt_rai}.get(afferent_type, 0.0),
+                     self.tau_adapt_rai_s if afferent_type == "RAI" else self.tau_adapt_sai_s,
                      self.gain(afferent_type), self.saturation(afferent_type), i_max,
-                     self.bias_saii if afferent_type == "SAII" else 0.0, tau)
+                     self.bias_saii if afferent_type == "SAII" else 0.0, tau,
+                     self.threshold_rai if afferent_type == "RAI" else 0.0)
 
 
 @dataclass(frozen=True)
@@ -244,6 +262,8 @@ class Stage:
         Tonic current in mV/ms.
     tau_s : float or None
         Time constant of the current's low-pass in s.
+    threshold : float
+        Dead zone of the rectified drive (RA-I's velocity threshold, N/s).
     """
 
     afferent_type: str
@@ -257,6 +277,7 @@ class Stage:
     i_max: float | None
     bias: float
     tau_s: float | None = None
+    threshold: float = 0.0
 
     @property
     def signed(self) -> bool:
@@ -513,9 +534,11 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
         x = x + state.offset
     if stage.derivative == 0 and stage.adapt > 0.0:
         x = np.maximum(x, 0.0)  # adaptation undershoots on release: a rate cannot go negative
+    if stage.derivative > 0 and (stage.adapt > 0.0 or stage.threshold > 0.0):
+        x, new_state = _adapt_rectified(np.abs(x), fs, stage, new_state)
     drive = gain * (x if stage.signed else np.abs(x))
     if noisy:
-        drive = _receptor_noise(drive, normals, noise_cv, fs)
+        drive = _receptor_noise(drive, normals, noise_cv, fs, stage.signed)
     current = np.sign(drive) * _transduce(np.abs(drive), stage) if stage.signed else _transduce(drive, stage)
     if stage.tau_s is not None:
         smooth = np.zeros(current.shape[1]) if new_state.smooth is None else new_state.smooth.copy()
@@ -526,11 +549,19 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     return current, new_state
 
 
-def _receptor_noise(drive, normals, noise_cv, fs):
-    """``d (1 + cv xi / sqrt(h))``, before the transducer; a rectified drive stays >= 0."""
+def _adapt_rectified(a, fs, stage, state):
+    """``max(a - adapt * LP(a) - threshold, 0)``, low-pass state in ``state.slow`` (RA-I's adaptation)."""
+    slow = np.zeros(a.shape[1]) if state.slow is None else state.slow.copy()
+    low = _smooth_kernel(np.ascontiguousarray(a), slow, float(-np.expm1(-1.0 / (fs * stage.tau_adapt_s))))
+    new_state = FilterState(state.zi, state.offset, state.y1, state.y2, slow, state.smooth)
+    return np.maximum((a - stage.adapt * low) - stage.threshold, 0.0), new_state
+
+
+def _receptor_noise(drive, normals, noise_cv, fs, signed=False):
+    """``d (1 + cv xi / sqrt(h))``, before the transducer; a rectified (unsigned) drive stays >= 0."""
     scale = np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs)
     noisy = drive + drive * (normals.T * scale)
-    return noisy if np.any(drive < 0) else np.maximum(noisy, 0.0)
+    return noisy if signed else np.maximum(noisy, 0.0)
 
 
 @nb.njit(cache=True, nogil=True)

@@ -18,9 +18,13 @@ Protocols (forces in N, +Z into the skin; the frame of `population.scenes`):
 * ``frequency``: sinusoidal normal force on a 1 N preload, 5-400 Hz, sampled
   at 5 kHz; per afferent the amplitude for one spike per cycle.
 * ``direction``: the Birznieks protocol (`population.tuning`).
-* ``timing``: first-spike-latency and count decoders of direction in 125 ms.
-* ``continuity``: F_A across a shear that reverses through zero, sampled at
-  10 kHz: the largest sample-to-sample step.
+* ``timing``: first-spike-latency and count (maximum-likelihood) decoders of
+  direction in 125 ms, each on ensembles of 92 SA-I, SA-II and FA-I afferents
+  (the size of Saal et al. 2009's sample), median over 5 ensembles; and the
+  first-spike jitter of FA-I over 10 trials.
+* ``continuity``: F_A across a shear that reverses through zero: the largest
+  sample-to-sample step at 10 kHz over that at 1 kHz (0.1 for a continuous
+  F_A with a bounded slope, 1 for a jump).
 """
 
 from __future__ import annotations
@@ -36,8 +40,6 @@ from .scenes import Scene, Stage, birznieks, press_push_lift, rotating_shear
 
 __all__ = ["Reference", "Property", "PROPERTIES", "PROTOCOLS", "shipped_scenes", "score_physiology",
            "summarise_scorecard"]
-
-_RECORDED = ("SAI", "SAII", "RAI")  # the types Birznieks et al. 2001 pooled into "86%"
 
 
 @dataclass(frozen=True)
@@ -117,7 +119,8 @@ PROPERTIES = dict([
        "fraction tuned over the recorded types (count-weighted mix of the per-type rows)"),
     _p("latency_vs_count", "all", "timing", "median error, first-spike latency / spike count decoder, 125 ms"),
     _p("jitter_RAI", "RAI", "timing", "first-spike jitter (SD over trials, median over afferents)", "ms"),
-    _p("continuity", "SAI+RAI+RAII", "continuity", "largest F_A step between 0.1 ms samples", "N"),
+    _p("continuity", "SAI+RAI+RAII", "continuity",
+       "largest F_A step at 10 kHz / at 1 kHz, shear reversing through zero"),
 ])
 #: The protocols, in the order they run.
 PROTOCOLS = ("rest", "on_off", "rates", "force_coding", "frequency", "direction", "timing", "continuity")
@@ -246,18 +249,47 @@ def _force_coding(population, context) -> dict:
 
 #: Frequencies (Hz) and amplitudes (N) of the vibration protocol.
 FREQUENCIES_HZ = (5.0, 8.0, 16.0, 32.0, 64.0, 100.0, 150.0, 200.0, 250.0, 300.0, 400.0)
-AMPLITUDES_N = tuple(np.geomspace(1e-4, 1.0, 17))
+AMPLITUDES_N = tuple(np.geomspace(1e-4, 1.0, 33))
 _VIBRATION_FS = 5000.0
 _VIBRATION_S = 0.5
+_VIBRATION_WINDOW = (0.1, 0.5)  # spikes are counted once the 50 ms onset has passed
 
 
 def _thresholds(ds, n_freq, n_amp):
-    """Per afferent and frequency, the amplitude (N) first giving one spike per cycle (inf: never)."""
-    counts = ds.spike_count.values.mean(axis=1).reshape(n_freq, n_amp, -1)  # over trials
-    per_cycle = counts / (np.asarray(FREQUENCIES_HZ)[:, None, None] * _VIBRATION_S)
-    reached = per_cycle >= 1.0
-    first = np.where(reached.any(axis=1), reached.argmax(axis=1), -1)
-    return np.where(first >= 0, np.asarray(AMPLITUDES_N)[np.maximum(first, 0)], np.inf)
+    """Per frequency and afferent, the amplitude (N) giving one spike per cycle (inf: never).
+
+    Interpolated log-linearly between the grid amplitudes around the crossing.
+    """
+    n_aff = ds.sizes["afferent"]
+    t0, t1 = _VIBRATION_WINDOW
+    keep = (ds.spike_time.values >= t0) & (ds.spike_time.values < t1)
+    counts = np.bincount(ds.spike_condition.values[keep] * n_aff + ds.spike_afferent.values[keep],
+                         minlength=ds.sizes["condition"] * n_aff).reshape(n_freq, n_amp, n_aff) / ds.sizes["trial"]
+    per_cycle = counts / (np.asarray(FREQUENCIES_HZ)[:, None, None] * (t1 - t0))
+    log_amp = np.log(np.asarray(AMPLITUDES_N))
+    out = np.full((n_freq, n_aff), np.inf)
+    for f in range(n_freq):
+        for j in range(n_aff):
+            above = np.flatnonzero(per_cycle[f, :, j] >= 1.0)
+            if above.size == 0:
+                continue
+            i = above[0]
+            if i == 0:
+                out[f, j] = AMPLITUDES_N[0]
+                continue
+            lo, hi = per_cycle[f, i - 1, j], per_cycle[f, i, j]
+            w = (1.0 - lo) / (hi - lo) if hi > lo else 1.0
+            out[f, j] = np.exp(log_amp[i - 1] + w * (log_amp[i] - log_amp[i - 1]))
+    return out
+
+
+def vibration_scene(frequency_hz: float, amplitude_n: float, name: str) -> Scene:
+    """A sinusoid on a 1 N preload at 5 kHz, its amplitude rising over 50 ms (raised cosine)."""
+    t = np.arange(int(round(_VIBRATION_S * _VIBRATION_FS))) / _VIBRATION_FS
+    envelope = np.where(t < 0.05, 0.5 - 0.5 * np.cos(np.pi * t / 0.05), 1.0)
+    fz = 1.0 + amplitude_n * envelope * np.sin(2 * np.pi * frequency_hz * t)
+    zero = np.zeros_like(t)
+    return Scene(zero, zero, fz, _VIBRATION_FS, name, (Stage("steady", _VIBRATION_WINDOW[0], _VIBRATION_WINDOW[1]),))
 
 
 def _frequency(population, context) -> dict:
@@ -266,10 +298,9 @@ def _frequency(population, context) -> dict:
         idx = np.flatnonzero(population.afferent_type == kind)
         if idx.size == 0:
             continue
-        sub = population.select(np.random.default_rng(context["seed"]).choice(idx, min(idx.size, 20), replace=False))
-        t = np.arange(int(_VIBRATION_S * _VIBRATION_FS)) / _VIBRATION_FS
-        scenes = [Scene(np.zeros_like(t), np.zeros_like(t), 1.0 + a * np.sin(2 * np.pi * f * t), _VIBRATION_FS,
-                        f"vib_{f:g}_{i}") for f in FREQUENCIES_HZ for i, a in enumerate(AMPLITUDES_N)]
+        pick = np.random.default_rng(context["seed"]).choice(idx, min(idx.size, 20), replace=False)
+        sub = population.select(np.sort(pick))
+        scenes = [vibration_scene(f, a, f"vib_{f:g}_{i}") for f in FREQUENCIES_HZ for i, a in enumerate(AMPLITUDES_N)]
         ds = _run(sub, scenes, context, record=("spikes",))
         thresholds = _thresholds(ds, len(FREQUENCIES_HZ), len(AMPLITUDES_N))
         curve = np.exp(np.median(np.log(thresholds), axis=1))  # median over afferents, inf-safe
@@ -292,52 +323,77 @@ def _direction(population, context) -> dict:
         if isinstance(summary["dsi"].get(kind), dict):
             out[f"dsi_mean_{kind}"] = summary["dsi"][kind]["mean"]
             out[f"dsi_sd_{kind}"] = summary["dsi"][kind]["sd"]
-    recorded = np.isin(tuning.afferent_type.values, _RECORDED) & (tuning.responsive.values == 1)
-    if recorded.any():
-        out["tuned_recorded"] = float(tuning.tuned.values[recorded].mean())
+    if isinstance(summary["tuned_fraction"]["recorded"], float):
+        out["tuned_recorded"] = summary["tuned_fraction"]["recorded"]
     return out, {"tuning": tuning}
+
+
+#: Afferents per decoded ensemble and ensembles in the timing protocol: the 92 afferents of
+#: Saal, Vijayakumar & Johansson 2009 (PHYSIOLOGY.md row 13), drawn from the types they recorded.
+TIMING_ENSEMBLE = 92
+TIMING_ENSEMBLES = 5
 
 
 def _timing(population, context) -> dict:
     from dataclasses import replace
 
-    from .decode import FirstSpikeLatency, MaximumLikelihood, angular_error
+    from .decode import FirstSpikeLatency, MaximumLikelihood, angular_error, select_afferents
 
     rng = np.random.default_rng(context["seed"])
-    if len(population) > 1000:  # decoders fit every afferent: a random 1000 keep the protocol's cost bounded
-        population = population.select(np.sort(rng.choice(len(population), 1000, replace=False)))
+    pool = np.flatnonzero(np.isin(population.afferent_type, ("SAI", "RAI", "SAII")))
+    picks = [np.sort(rng.choice(pool, min(pool.size, TIMING_ENSEMBLE), replace=False))
+             for _ in range(TIMING_ENSEMBLES)]
+    used = np.unique(np.concatenate(picks))
+    sub = population.select(used)
     make = lambda n, p: [replace(birznieks(float(d)), name=f"{p}{i}") for i, d in enumerate(rng.uniform(0, 360, n))]  # noqa: E731
-    train, test = _run(population, make(120, "train"), context), _run(population, make(60, "test"), context)
-    err = {cls.__name__: np.median(angular_error(cls(0.125).fit(train).predict(test).values.ravel(),
-                                                 test.theta_r.values)) for cls in (FirstSpikeLatency, MaximumLikelihood)}
-    out = {"latency_vs_count": float(err["FirstSpikeLatency"] / max(err["MaximumLikelihood"], 1e-9))}
+    train, test = _run(sub, make(120, "train"), context), _run(sub, make(60, "test"), context)
+    err = {"FirstSpikeLatency": [], "MaximumLikelihood": []}
+    for pick in picks:
+        local = np.searchsorted(used, pick)
+        tr, te = select_afferents(train, local), select_afferents(test, local)
+        for cls in (FirstSpikeLatency, MaximumLikelihood):
+            decoded = cls(0.125).fit(tr).predict(te).values.ravel()
+            err[cls.__name__].append(float(np.median(angular_error(decoded, te.theta_r.values))))
+    median = {k: float(np.median(v)) for k, v in err.items()}
+    out = {"latency_vs_count": median["FirstSpikeLatency"] / max(median["MaximumLikelihood"], 1e-9)}
+    out.update(_jitter(population, context))
+    return out, {"errors_deg": median}
+
+
+def _jitter(population, context) -> dict:
+    """Median over RA-I afferents of the SD of their first-spike time over 10 Birznieks trials (ms)."""
     ra = population.select(population.afferent_type == "RAI")
-    if len(ra):
-        ds = _run(ra, [birznieks(90.0)], context, trials=10)
-        first = np.full((10, len(ra)), np.nan)
-        for trial in range(10):
-            keep = ds.spike_trial.values == trial
-            times, aff = ds.spike_time.values[keep][::-1], ds.spike_afferent.values[keep][::-1]
-            first[trial, aff] = times  # reversed: the earliest spike is written last
-        fired = np.all(np.isfinite(first), axis=0)
-        out["jitter_RAI"] = float(np.median(np.std(first[:, fired], axis=0, ddof=1)) * 1e3) if fired.any() else 0.0
-    return out, {"errors_deg": err}
+    if not len(ra):
+        return {}
+    ds = _run(ra, [birznieks(90.0)], context, trials=10)
+    first = np.full((10, len(ra)), np.nan)
+    for trial in range(10):
+        keep = ds.spike_trial.values == trial
+        times, aff = ds.spike_time.values[keep][::-1], ds.spike_afferent.values[keep][::-1]
+        first[trial, aff] = times  # reversed: the earliest spike is written last
+    fired = np.all(np.isfinite(first), axis=0)
+    return {"jitter_RAI": float(np.median(np.std(first[:, fired], axis=0, ddof=1)) * 1e3) if fired.any() else 0.0}
 
 
-def _continuity(population, context) -> dict:
-    """The largest sample-to-sample F_A step when the shear reverses through zero at 10 kHz."""
-    fs = 10_000.0
-    t = np.arange(int(0.4 * fs)) / fs
-    fy = 1.0 * np.cos(2 * np.pi * t / 0.4)  # distal, through zero at 0.1 s, proximal, back through 0.3 s
+def _max_step(population, fs, no_shear):
+    """Largest sample-to-sample F_A step (N) when the shear reverses through zero, sampled at ``fs``."""
+    t = np.arange(int(round(0.4 * fs))) / fs
+    fy = np.cos(2 * np.pi * t / 0.4)  # 1 N distal, through zero at 0.1 s, proximal, back through 0.3 s
     fz = np.full_like(t, 2.0)
     worst = 0.0
     tuned = np.flatnonzero((population.nap != "none") & (population.afferent_type != "SAII"))
     for profile in np.unique(population.nap[tuned]):
         cols = tuned[population.nap[tuned] == profile][:200]
         af = attenuation_factor(np.zeros_like(t), fy, population.theta_t[cols], str(profile), population.k[cols],
-                                no_shear=context["no_shear"])
+                                no_shear=no_shear)
         worst = max(worst, float(np.max(np.abs(np.diff(af * fz[:, None], axis=0)))))
-    return {"continuity": worst}, {}
+    return worst
+
+
+def _continuity(population, context) -> dict:
+    """Largest F_A step at 10 kHz over that at 1 kHz: ~0.1 when F_A is continuous, ~1 at a jump."""
+    fine, coarse = (_max_step(population, fs, context["no_shear"]) for fs in (10_000.0, 1_000.0))
+    return {"continuity": fine / coarse if coarse > 0 else 0.0}, {"step_10khz_n": fine, "step_1khz_n": coarse}
 
 
 _RUNNERS = {"rest": _rest, "on_off": _on_off, "rates": _shipped_rates, "force_coding": _force_coding,

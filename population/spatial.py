@@ -17,7 +17,7 @@ from models.currents import AFFERENT_TYPES
 __all__ = ["RF_SIGMA_MM", "RF_SUPPORT", "receptive_field_weight"]
 
 #: Receptive-field fall-off width (Gaussian sigma) per type, in mm.
-RF_SIGMA_MM = {"SAI": 1.0, "RAI": 1.5, "RAII": 8.0}
+RF_SIGMA_MM = {"SAI": 1.0, "RAI": 1.5, "RAII": 8.0, "SAII": 2.2}  # SA-II: ~5x the SA-I field area (row 17)
 #: Weights are exactly 0 beyond this many widths outside the contact.
 RF_SUPPORT = 3.0
 

@@ -142,7 +142,7 @@ class Encoder:
             self._pending.result()  # let an in-flight draw finish before its streams are dropped
         self._pending = None
         self._filters, self._neuron, self._samples, self._last_time = {}, None, 0, None
-        noisy = np.any(self._pop.noise_sigma > 0)
+        noisy = np.any(self._pop.noise_sigma > 0) or np.any(self._pop.noise_cv > 0)
         self._streams = noise_streams(self.seed, 0, 0, self._pop.afferent_id) if noisy else None
         self._blocks = deque()  # noise drawn ahead, oldest first; rows before _noise_pos are used
         self._noise_pos = 0

@@ -21,7 +21,7 @@ def test_tuning_json_and_figures(capsys, tmp_path):
     code, out, _ = run(capsys, "tuning", "--population", "fingertip", "--seed", "2", "--json", "--out", tmp_path)
     assert code == 0
     result = json.loads(out)
-    assert set(result["tuned_fraction"]) == {"all", "SAI", "RAI", "RAII"}
+    assert set(result["tuned_fraction"]) == {"all", "recorded", "SAI", "RAI", "RAII", "SAII"}
     assert set(result["dsi"]["SAI"]) == {"mean", "sd"} and "reference" in result
     assert {"tuning.json", "dsi_histograms.png", "preferred_directions.png"} <= {p.name for p in tmp_path.iterdir()}
 
@@ -67,4 +67,5 @@ def test_calibration_reproduces_the_committed_preset():
     committed = load_spec("fingertip")
     assert spec.current.i_sat_sai == pytest.approx(committed.current.i_sat_sai, rel=0.02)
     assert spec.current.g_rai == pytest.approx(committed.current.g_rai, rel=0.02)
-    assert np.isclose(report["validation"]["mean_sd"]["tuned_fraction.all"][0], 0.86, atol=0.03)
+    assert np.isclose(report["validation"]["mean_sd"]["tuned_fraction.recorded"][0], 0.86, atol=0.03)
+    assert all(v["all_pass"] for v in report["validation"]["scorecard_all_pass"].values())

@@ -38,12 +38,16 @@ def test_shear_at_just_above_and_just_below_threshold(engine):
     n = 300
     sel = make_population(["SAI"] * 2, [180.0, 0.0], "selective")  # opposed and aligned to +X
     out = {}
-    for name, fx in (("at", F_TH), ("above", F_TH * (1 + 1e-9)), ("below", F_TH * (1 - 1e-9))):
-        ds = simulate(sel, Scene(np.full(n, fx), np.zeros(n), np.full(n, 3.0), name=name), engine=engine,
-                      quiet=True)
-        out[name] = ds.spike_count.values[0, 0]
-    np.testing.assert_array_equal(out["at"], out["below"])  # eq. 17: AF = 1 up to and including F_TH
-    assert out["above"][0] < out["at"][0] and out["above"][1] == out["at"][1]
+    for reading in ("pass", "smooth"):
+        for name, fx in (("at", F_TH), ("above", F_TH * (1 + 1e-9)), ("below", F_TH * (1 - 1e-9))):
+            ds = simulate(sel, Scene(np.full(n, fx), np.zeros(n), np.full(n, 3.0), name=name), engine=engine,
+                          quiet=True, no_shear=reading)
+            out[reading, name] = ds.spike_count.values[0, 0]
+    np.testing.assert_array_equal(out["pass", "at"], out["pass", "below"])  # eq. 17: AF = 1 up to F_TH
+    assert out["pass", "above"][0] < out["pass", "at"][0] and out["pass", "above"][1] == out["pass", "at"][1]
+    # the smooth reading has no step at F_TH: 1e-9 N either side changes nothing
+    np.testing.assert_array_equal(out["smooth", "above"], out["smooth", "below"])
+    assert out["smooth", "above"][0] < out["pass", "at"][0]
 
 
 @pytest.mark.parametrize("engine", ENGINES)

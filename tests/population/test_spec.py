@@ -7,8 +7,10 @@ from population.spec import load_spec, spec_from_dict
 
 
 @pytest.mark.parametrize("name", ["fingertip", "hand"])
-def test_presets_have_touchsim_counts(name):
-    assert load_spec(name).n_afferents() == TOUCHSIM_COUNTS[name]
+def test_presets_have_touchsim_counts_plus_sa2_at_the_row_16_ratio(name):
+    counts = load_spec(name).n_afferents()
+    assert {k: counts[k] for k in ("SAI", "RAI", "RAII")} == TOUCHSIM_COUNTS[name]
+    assert counts["SAII"] == round(TOUCHSIM_COUNTS[name]["SAI"] * 9 / 70)  # SA-II 9 vs SA-I 70 per cm^2
 
 
 def test_density_gives_count_over_region():

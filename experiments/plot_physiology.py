@@ -1,0 +1,100 @@
+"""Figures of the physiology scorecard: each helper takes a protocol's data and returns a Figure."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from models.currents import AFFERENT_TYPES
+from population.physiology import FREQUENCIES_HZ
+
+from .plotting import _TYPE_COLOURS, plot_dsi_histograms
+
+__all__ = ["plot_rest", "plot_on_off", "plot_force_coding", "plot_frequency_tuning", "plot_timing",
+           "physiology_figures"]
+
+
+def plot_rest(data: dict) -> Figure:
+    """Resting rate of every afferent (60 s of zero force), by type."""
+    fig = Figure(figsize=(6.0, 3.2), layout="constrained")
+    ax = fig.add_subplot()
+    kinds = [k for k in AFFERENT_TYPES if np.any(data["type"] == k)]
+    for i, kind in enumerate(kinds):
+        rate = data["rate"][data["type"] == kind]
+        ax.scatter(np.full(rate.size, i) + np.linspace(-0.3, 0.3, rate.size), rate, s=4,
+                   color=_TYPE_COLOURS[kind])
+    ax.set_xticks(range(len(kinds)), kinds)
+    ax.set_ylabel("rate at rest (pulses/s)")
+    ax.set_title("rest: 60 s of zero force")
+    return fig
+
+
+def plot_on_off(data: dict, bin_s: float = 0.02) -> Figure:
+    """PSTH per type on the on/off protocol (0 -> 4 N at 10 N/s, 2 s hold, release), with the force."""
+    ds = data["dataset"]
+    kinds = [k for k in AFFERENT_TYPES if np.any(ds.afferent_type.values == k)]
+    fig = Figure(figsize=(7.0, 1.6 * (len(kinds) + 1)), layout="constrained")
+    axes = fig.subplots(len(kinds) + 1, 1, sharex=True)
+    axes[0].plot(ds.time.values, ds.fz.values[0], color="k")
+    axes[0].set_ylabel("F_Z (N)")
+    edges = np.arange(0.0, float(ds.duration[0]) + bin_s, bin_s)
+    for ax, kind in zip(axes[1:], kinds):
+        own = ds.afferent_type.values[ds.spike_afferent.values] == kind
+        counts, _ = np.histogram(ds.spike_time.values[own], edges)
+        ax.bar(edges[:-1], counts / bin_s / np.sum(ds.afferent_type.values == kind), width=bin_s, align="edge",
+               color=_TYPE_COLOURS[kind])
+        ax.set_ylabel(f"{kind}\n(pulses/s)", fontsize=8)
+    axes[-1].set_xlabel("time (s)")
+    return fig
+
+
+def plot_force_coding(data: dict) -> Figure:
+    """SA-I plateau rate against normal force, FA-I loading count against force rate."""
+    fig = Figure(figsize=(8.0, 3.2), layout="constrained")
+    a, b = fig.subplots(1, 2)
+    if "sai_plateau" in data:
+        a.plot([1, 2, 4], data["sai_plateau"], "o-", color=_TYPE_COLOURS["SAI"])
+    a.set_xlabel("normal force (N)")
+    a.set_ylabel("SA-I plateau rate (pulses/s)")
+    if "rai_loading_counts" in data:
+        b.semilogx([2, 8, 32], data["rai_loading_counts"], "o-", color=_TYPE_COLOURS["RAI"])
+    b.set_xlabel("force rate (N/s)")
+    b.set_ylabel("RA-I spikes during loading")
+    return fig
+
+
+def plot_frequency_tuning(data: dict) -> Figure:
+    """Median amplitude for one spike per cycle against frequency (log-log), per type."""
+    fig = Figure(figsize=(5.5, 3.6), layout="constrained")
+    ax = fig.add_subplot()
+    for kind, curve in data.items():
+        curve = np.asarray(curve, dtype=float)
+        finite = np.isfinite(curve)
+        ax.loglog(np.asarray(FREQUENCIES_HZ)[finite], curve[finite], "o-", color=_TYPE_COLOURS[kind], label=kind)
+    ax.axvspan(8, 64, color=_TYPE_COLOURS["RAI"], alpha=0.1)
+    ax.axvspan(150, 400, color=_TYPE_COLOURS["RAII"], alpha=0.1)
+    ax.set_xlabel("frequency (Hz), 1 N preload")
+    ax.set_ylabel("amplitude for 1 spike/cycle (N)")
+    ax.legend()
+    return fig
+
+
+def plot_timing(data: dict) -> Figure:
+    """Median decoding error of the first-spike-latency and count decoders at 125 ms."""
+    fig = Figure(figsize=(4.5, 3.2), layout="constrained")
+    ax = fig.add_subplot()
+    names = list(data["errors_deg"])
+    ax.bar(names, [data["errors_deg"][n] for n in names], color=["tab:gray", "tab:blue"])
+    ax.set_ylabel("median error (deg), 125 ms")
+    return fig
+
+
+def physiology_figures(data: dict, human_dsi: dict) -> dict:
+    """File name -> Figure for every protocol that ran and has a figure."""
+    makers = {"rest": ("rest.png", plot_rest), "on_off": ("on_off_psth.png", plot_on_off),
+              "force_coding": ("force_coding.png", plot_force_coding),
+              "frequency": ("frequency_tuning.png", plot_frequency_tuning), "timing": ("timing.png", plot_timing)}
+    out = {name: make(data[protocol]) for protocol, (name, make) in makers.items() if data.get(protocol)}
+    if data.get("direction"):
+        out["tuning_dsi.png"] = plot_dsi_histograms(data["direction"]["tuning"], human_dsi)
+    return out

@@ -1,0 +1,124 @@
+"""Type-specific current stages: filters, adaptation, transducers, receptor noise, smoothing, SA-II."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from models.currents import CurrentParams, afferent_current, check_fs, current_core
+
+FS = 1000.0
+#: The physiological stages of the presets (population/presets/fingertip.toml).
+PHYSIO = CurrentParams(g_sai=6.0, cutoff_sai_hz=50.0, adapt_sai=1.0, tau_adapt_sai_s=0.5, i_max_sai=60.0,
+                       tau_sai_s=0.015, g_rai=4.5, cutoff_rai_hz=40.0, adapt_rai=0.7, tau_adapt_rai_s=0.1,
+                       threshold_rai=2.0, i_max_rai=60.0, tau_rai_s=0.015, g_raii=0.01, cutoff_raii_hz=300.0,
+                       order_raii=4, i_max_raii=200.0, tau_raii_s=0.04, g_saii=4.0, bias_saii=5.0,
+                       opponent_saii=0.5, i_max_saii=40.0, tau_saii_s=0.015)
+TYPES = ("SAI", "RAI", "RAII", "SAII")
+
+
+def ramp_hold(rate_n_s=10.0, peak=4.0, hold_s=2.0):
+    ramp = np.arange(0.0, peak, rate_n_s / FS)
+    return np.r_[np.zeros(100), ramp, np.full(int(hold_s * FS), peak), ramp[::-1], np.zeros(300)][:, None]
+
+
+def test_paper_stage_is_the_default():
+    # The defaults are eqs 1-3 verbatim: SAI = g |F|, with no filter and no state.
+    f = np.linspace(0.0, 2.0, 50)[:, None]
+    i, state = afferent_current(f, FS, "SAI")
+    np.testing.assert_array_equal(i, CurrentParams().g_sai * f)
+    assert state is None
+
+
+@pytest.mark.parametrize("kind", TYPES)
+def test_zero_force_gives_bias_only(kind):
+    i, _ = afferent_current(np.zeros((500, 3)), FS, kind, PHYSIO)
+    np.testing.assert_array_equal(i, PHYSIO.bias_saii if kind == "SAII" else 0.0)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), scale=st.floats(0.01, 1e4), cv=st.floats(0.0, 3.0),
+       kind=st.sampled_from(("SAI", "RAI", "RAII")))
+def test_transducer_bound_holds_with_receptor_noise(seed, scale, cv, kind):
+    rng = np.random.default_rng(seed)
+    f = np.abs(rng.normal(size=(400, 4)).cumsum(axis=0)) * scale
+    normals = rng.standard_normal((4, 400))
+    i, _ = current_core(f, FS, kind, PHYSIO, None, None, normals, np.full(4, cv))
+    bound = {"SAI": PHYSIO.i_max_sai, "RAI": PHYSIO.i_max_rai, "RAII": PHYSIO.i_max_raii}[kind]
+    assert np.all(i >= 0.0) and np.all(i <= bound)
+
+
+def test_receptor_noise_leaves_an_undriven_afferent_at_zero():
+    normals = np.random.default_rng(0).standard_normal((2, 300))
+    i, _ = current_core(np.zeros((300, 2)), FS, "RAI", PHYSIO, None, None, normals, np.full(2, 2.0))
+    np.testing.assert_array_equal(i, 0.0)
+
+
+@pytest.mark.parametrize("kind", TYPES)
+def test_chunks_give_the_currents_of_the_whole_signal(kind):
+    rng = np.random.default_rng(1)
+    f = np.abs(rng.normal(size=(900, 3)).cumsum(axis=0)) * 0.05
+    normals = rng.standard_normal((3, 900))
+    cv = np.full(3, 0.5)
+    whole, _ = current_core(f, FS, kind, PHYSIO, None, None, normals, cv)
+    parts, state = [], None
+    for a, b in ((0, 1), (1, 250), (250, 251), (251, 900)):
+        part, state = current_core(f[a:b], FS, kind, PHYSIO, state, None, normals[:, a:b], cv)
+        if state is None:  # first chunk created the state from its first sample: same as the whole run
+            pass
+        parts.append(part)
+    np.testing.assert_array_equal(np.concatenate(parts), whole)
+
+
+def test_sa1_adapts_through_a_hold_and_is_silent_on_release():
+    f = ramp_hold()
+    i, _ = afferent_current(f, FS, "SAI", PHYSIO)
+    hold = slice(100 + 400, 100 + 400 + 2000)
+    early, late = i[hold][:500].mean(), i[hold][-500:].mean()
+    assert late < 0.8 * early  # decays through the hold (tau 0.5 s)
+    up, down = i[100 + 200, 0], i[100 + 400 + 2000 + 200, 0]  # both at 2 N, loading and unloading
+    assert down < 0.5 * up  # the adaptation undershoots on release: SA-I fall silent early
+    assert i[100 + 400 + 2000 + 450:].max() < 1e-3 * late  # rectified: the undershoot never excites
+
+
+def test_ra1_adapts_to_a_sustained_velocity_and_ignores_slow_changes():
+    slow, _ = afferent_current(ramp_hold(rate_n_s=1.5), FS, "RAI", PHYSIO)
+    assert slow.max() == 0.0  # 1.5 N/s is inside the 2 N/s dead zone
+    fast, _ = afferent_current(ramp_hold(rate_n_s=10.0), FS, "RAI", PHYSIO)
+    ramp = fast[100:500, 0]
+    assert ramp[300:].mean() < 0.6 * ramp[50:150].mean()  # adapts during a constant-velocity ramp
+
+
+def test_ra2_is_a_pacinian_band_pass():
+    t = np.arange(5000) / 5000.0
+
+    def response(freq):
+        f = (1.0 + 0.001 * np.sin(2 * np.pi * freq * t))[:, None]
+        i, _ = afferent_current(f, 5000.0, "RAII", PHYSIO.__class__(**{**PHYSIO.__dict__, "i_max_raii": None}))
+        return i[2500:].mean()
+
+    gains = {f: response(f) for f in (20.0, 100.0, 250.0, 600.0)}
+    assert gains[100.0] > 10 * gains[20.0]  # acceleration: ~f^2 below the cut-off
+    assert gains[250.0] > gains[100.0] and gains[250.0] > gains[600.0]
+
+
+def test_a_scene_too_slow_for_ra2_is_refused():
+    with pytest.raises(ValueError, match="too slow for RAII.*>= 750 Hz"):
+        check_fs(500.0, PHYSIO)
+    check_fs(1000.0, PHYSIO)
+    with pytest.raises(ValueError, match="RAII"):
+        afferent_current(np.zeros((10, 1)), 500.0, "RAII", PHYSIO)
+
+
+def test_sa2_stretch_raises_and_lowers_the_tonic_current():
+    drive = np.r_[np.zeros(200), np.full(800, 1.0), np.full(800, -0.5)][:, None]
+    i, _ = afferent_current(drive, FS, "SAII", PHYSIO)
+    assert i[150, 0] == PHYSIO.bias_saii
+    assert i[900, 0] > PHYSIO.bias_saii + 3.0 and i[1700, 0] < PHYSIO.bias_saii - 1.0
+
+
+@pytest.mark.parametrize("field,value", [("i_max_rai", -1.0), ("tau_sai_s", 0.0), ("adapt_rai", -0.1),
+                                         ("threshold_rai", np.nan), ("order_raii", 9), ("cutoff_raii_hz", 0.0)])
+def test_bad_stage_parameters_are_named(field, value):
+    with pytest.raises(ValueError, match=field):
+        CurrentParams(**{field: value})
