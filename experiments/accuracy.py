@@ -1,6 +1,6 @@
 """``ddmm accuracy``: what a coarser step or a cheaper method costs in fidelity.
 
-Workload: the fingertip preset with its noise switched off (so every run is
+Workload: the fingertip preset with both its noises switched off (so every run is
 deterministic and comparable), on the Birznieks scene in 8 directions
 (0, 45, ..., 315 deg).  Each (dt, method, engine) run goes through the whole
 `population.simulate` pipeline and is compared with the reference solver
@@ -47,7 +47,7 @@ REF_DT = 5e-6
 def workload(population="fingertip", seed: int = 0, directions=DIRECTIONS, scene=birznieks):
     """The population with noise off, and one scene per direction."""
     spec = load_spec(population)
-    quiet = spec.replace(types={k: dataclasses.replace(t, noise_sigma=0.0) for k, t in spec.types.items()})
+    quiet = spec.replace(types={k: dataclasses.replace(t, noise_sigma=0.0, noise_cv=0.0) for k, t in spec.types.items()})
     return sample_population(quiet, rng=seed), [scene(d) for d in directions]
 
 

@@ -165,6 +165,8 @@ def _subprocess_case(name: str) -> dict:
 
 
 def _cold_start(engine: str) -> tuple[dict, float]:
+    from population import load_spec
+
     """Time a fresh ``ddmm simulate`` process; first run once to fill caches.
 
     The process runs the CLI and then prints its own peak RSS; the wall time,
@@ -178,9 +180,10 @@ def _cold_start(engine: str) -> tuple[dict, float]:
             out = subprocess.run(cmd, check=True, capture_output=True, text=True)
             walls.append(time.perf_counter() - start)
             rss = json.loads(out.stdout.strip().splitlines()[-1])["peak_rss_mb"]
-    case = {"name": f"cold_start_{engine}", "engine": engine, "n_afferents": 955, "sim_s": 0.5,
+    n = sum(load_spec("fingertip").n_afferents().values())
+    case = {"name": f"cold_start_{engine}", "engine": engine, "n_afferents": n, "sim_s": 0.5,
             "dt_ms": DT * 1e3, "wall_s": round(walls[1], 3),
-            "afferent_s_per_wall_s": round(955 * 0.5 / walls[1], 1), "peak_rss_mb": rss}
+            "afferent_s_per_wall_s": round(n * 0.5 / walls[1], 1), "peak_rss_mb": rss}
     return case, round(max(0.0, walls[0] - walls[1]), 3)
 
 

@@ -8,12 +8,18 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from models.currents import AFFERENT_TYPES
+from models.currents import AFFERENT_TYPES, PAPER_TYPES
 
 __all__ = ["plot_response", "plot_sf_vs_theta", "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces",
            "plot_dsi_histograms", "plot_preferred_rose", "plot_neurometric", "plot_pareto"]
 
 _TYPE_COLOURS = {"SAI": "tab:blue", "RAI": "tab:orange", "RAII": "tab:green", "SAII": "tab:purple"}
+
+
+def _present(types) -> list:
+    """The afferent types present, in the package's order (at least one entry for an empty figure)."""
+    present = [k for k in AFFERENT_TYPES if np.any(np.asarray(types) == k)]
+    return present or [AFFERENT_TYPES[0]]
 
 
 def _plot_forces(ax, time, forces):
@@ -57,14 +63,14 @@ def plot_response(data: dict, *, title: str = "", bin_s: float | None = None) ->
     bin_s = duration / 30.0 if bin_s is None else bin_s
     conds = data["conditions"]
     fig = Figure(figsize=(5.0 * len(conds), 9.0), layout="constrained")
-    axes = fig.subplots(2 + len(AFFERENT_TYPES), len(conds), sharex=True, squeeze=False)
+    axes = fig.subplots(2 + len(PAPER_TYPES), len(conds), sharex=True, squeeze=False)
     for col, cond in enumerate(conds):
         _plot_forces(axes[0, col], time, data["forces"])
         axes[0, col].set_title(cond["label"], fontsize=10)
         axes[1, col].plot(time, cond["af"], color="purple", lw=1.2)
         axes[1, col].set_ylim(-0.05, 1.05)
         axes[1, col].set_ylabel("AF(t)")
-        for row, kind in enumerate(AFFERENT_TYPES, start=2):
+        for row, kind in enumerate(PAPER_TYPES, start=2):
             _plot_spikes(axes[row, col], np.asarray(cond["spikes"][kind]), duration, bin_s,
                          _TYPE_COLOURS[kind], kind)
         axes[-1, col].set_xlabel("time (s)")
@@ -86,7 +92,7 @@ def plot_sf_vs_theta(sf: dict, *, title: str = "SF against tuning angle (Fig. 8)
     fig = Figure(figsize=(3.6 * len(profiles), 3.4), layout="constrained")
     axes = fig.subplots(1, len(profiles), sharey=True, squeeze=False)[0]
     for ax, profile in zip(axes, profiles):
-        for kind in AFFERENT_TYPES:
+        for kind in PAPER_TYPES:
             angles = np.array([float(a) for a in sf[profile][kind]])
             values = np.array(list(sf[profile][kind].values()), dtype=float)
             ax.plot(angles, values, "o-", ms=3, color=_TYPE_COLOURS[kind], label=kind)
@@ -154,9 +160,10 @@ def plot_psth(rates) -> Figure:
 def plot_polar_counts(ds, *, condition=0) -> Figure:
     """Polar plot of spike count (mean over trials) against theta_T, per type."""
     counts = ds.spike_count.isel(condition=condition).mean("trial").values
-    fig = Figure(figsize=(4.0 * len(AFFERENT_TYPES), 4.0), layout="constrained")
-    for i, kind in enumerate(AFFERENT_TYPES):
-        ax = fig.add_subplot(1, len(AFFERENT_TYPES), i + 1, projection="polar")
+    kinds = _present(ds.afferent_type.values)
+    fig = Figure(figsize=(4.0 * len(kinds), 4.0), layout="constrained")
+    for i, kind in enumerate(kinds):
+        ax = fig.add_subplot(1, len(kinds), i + 1, projection="polar")
         sel = ds.afferent_type.values == kind
         ax.scatter(np.deg2rad(ds.theta_t.values[sel]), counts[sel], s=4, color=_TYPE_COLOURS[kind])
         ax.set_title(kind)
@@ -179,9 +186,10 @@ def plot_forces(ds) -> Figure:
 
 def plot_dsi_histograms(tuning, reference: dict | None = None) -> Figure:
     """DSI histogram per afferent type (responsive afferents), with the human mean +- SD."""
-    fig = Figure(figsize=(4.0 * len(AFFERENT_TYPES), 3.2), layout="constrained")
-    axes = fig.subplots(1, len(AFFERENT_TYPES), sharey=False, squeeze=False)[0]
-    for ax, kind in zip(axes, AFFERENT_TYPES):
+    kinds = _present(tuning.afferent_type.values)
+    fig = Figure(figsize=(4.0 * len(kinds), 3.2), layout="constrained")
+    axes = fig.subplots(1, len(kinds), sharey=False, squeeze=False)[0]
+    for ax, kind in zip(axes, kinds):
         sel = (tuning.afferent_type.values == kind) & (tuning.responsive.values == 1)
         values = tuning.dsi.values[sel]
         ax.hist(values, bins=np.linspace(0, 1, 21), color=_TYPE_COLOURS[kind], alpha=0.7)

@@ -331,7 +331,7 @@ def _direction(population, context) -> dict:
 #: Afferents per decoded ensemble and ensembles in the timing protocol: the 92 afferents of
 #: Saal, Vijayakumar & Johansson 2009 (PHYSIOLOGY.md row 13), drawn from the types they recorded.
 TIMING_ENSEMBLE = 92
-TIMING_ENSEMBLES = 5
+TIMING_ENSEMBLES = 10
 
 
 def _timing(population, context) -> dict:
@@ -346,7 +346,7 @@ def _timing(population, context) -> dict:
     used = np.unique(np.concatenate(picks))
     sub = population.select(used)
     make = lambda n, p: [replace(birznieks(float(d)), name=f"{p}{i}") for i, d in enumerate(rng.uniform(0, 360, n))]  # noqa: E731
-    train, test = _run(sub, make(120, "train"), context), _run(sub, make(60, "test"), context)
+    train, test = _run(sub, make(150, "train"), context), _run(sub, make(120, "test"), context)
     err = {"FirstSpikeLatency": [], "MaximumLikelihood": []}
     for pick in picks:
         local = np.searchsorted(used, pick)

@@ -188,7 +188,7 @@ def sample_population(spec, rng=None) -> Population:
     --------
     >>> pop = sample_population("fingertip", rng=1)
     >>> len(pop), pop.counts()
-    (955, {'SAI': 282, 'RAI': 573, 'RAII': 100})
+    (991, {'SAI': 282, 'RAI': 573, 'RAII': 100, 'SAII': 36})
     """
     spec = load_spec(spec)
     if not isinstance(spec, PopulationSpec):  # pragma: no cover - load_spec guarantees it

@@ -24,7 +24,7 @@ def test_simulate_info_plot(capsys, tmp_path):
     ds = load_dataset(out)
     assert ds.sizes["condition"] == 3 and ds.sizes["trial"] == 2 and ds.attrs["dt"] == pytest.approx(5e-5)
     code, text, _ = run(capsys, "info", out)
-    assert code == 0 and "955 afferents" in text and "birznieks_90" in text
+    assert code == 0 and "991 afferents" in text and "birznieks_90" in text
     code, text, _ = run(capsys, "plot", out, "--out", tmp_path / "figs")
     assert code == 0
     assert {p.name for p in (tmp_path / "figs").iterdir()} == {"raster.png", "psth.png", "polar.png", "forces.png"}
@@ -95,5 +95,5 @@ def test_bench_case_shape():
     result = run_case("fingertip_1s_direct")
     assert {"name", "engine", "n_afferents", "sim_s", "dt_ms", "wall_s", "afferent_s_per_wall_s",
             "peak_rss_mb"} <= set(result)
-    assert result["n_afferents"] == 955 and set(CASES) >= {"hand_1s_direct", "hand_10s_direct"}
+    assert result["n_afferents"] == 991 and set(CASES) >= {"hand_1s_direct", "hand_10s_direct"}
     json.dumps(result)

@@ -66,7 +66,7 @@ def test_select_afferents_remaps_events(train):
 
 
 def test_real_spikes_decode():
-    pop = sample_population("fingertip", rng=3).select(np.arange(0, 955, 3))
+    pop = sample_population("fingertip", rng=3).select(np.arange(0, 991, 3))
     rng = np.random.default_rng(3)
     scenes = lambda n, p: [__import__("dataclasses").replace(birznieks(float(d)), name=f"{p}{i}")  # noqa: E731
                             for i, d in enumerate(rng.uniform(0, 360, n))]

@@ -23,7 +23,7 @@ def client():
 
 @pytest.fixture(scope="module")
 def pop():
-    return sample_population("fingertip", rng=1).select(np.arange(0, 955, 4))  # 239 afferents, noisy
+    return sample_population("fingertip", rng=1).select(np.arange(0, 991, 4))  # 248 afferents, noisy
 
 
 @pytest.mark.parametrize("engine", ["direct", "brian2"])

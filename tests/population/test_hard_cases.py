@@ -17,7 +17,7 @@ from tests.conftest import ENGINES
 
 @pytest.fixture(scope="module")
 def pop():
-    return sample_population("fingertip", rng=7).select(np.arange(0, 955, 19))  # 51 afferents, noisy
+    return sample_population("fingertip", rng=7).select(np.arange(0, 991, 19))  # 53 afferents, noisy
 
 
 def finite(ds):
@@ -77,7 +77,7 @@ def test_100hz_force_plate_with_sensor_noise(engine, tmp_path):
     path = tmp_path / "plate.csv"
     path.write_text("time,fx,fy,fz\n" + rows)
     scene = from_csv(path, negative_fz="clip")
-    ds = simulate(sample_population("fingertip", rng=1).select(np.arange(0, 955, 9)), scene, engine=engine,
+    ds = simulate(sample_population("fingertip", rng=1).select(np.arange(0, 991, 9)), scene, engine=engine,
                   seed=1, quiet=True)
     rates = ds.spike_count.values[0, 0] / scene.duration
     assert finite(ds) and rates.max() < 500.0  # the derivative filter keeps sensor noise from exploding RAII
@@ -108,7 +108,7 @@ def test_ten_minute_scene_memory_is_bounded(engine):
 @settings(max_examples=8, deadline=None)
 @given(alpha=st.floats(0.0, 360.0), engine=st.sampled_from(ENGINES))
 def test_rotating_shear_and_tuning_together_leaves_spikes_unchanged(alpha, engine):
-    base = sample_population("fingertip", rng=0).select(np.arange(0, 955, 23))
+    base = sample_population("fingertip", rng=0).select(np.arange(0, 991, 23))
     turned = dataclasses.replace(base, theta_t=(base.theta_t + alpha) % 360.0)  # same ids, same noise
     scene = birznieks(37.0)
     r = np.deg2rad(alpha)

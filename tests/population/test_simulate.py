@@ -22,7 +22,7 @@ def fingertip():
 
 @pytest.fixture(scope="module")
 def small(fingertip):
-    return fingertip.select(np.arange(0, 955, 7))  # 137 afferents of all types, noisy
+    return fingertip.select(np.arange(0, 991, 7))  # 142 afferents of all four types, noisy
 
 
 def scenes():
@@ -148,7 +148,7 @@ def test_same_seed_same_spikes_across_processes():
     import subprocess
     import sys
     code = ("from population import sample_population, simulate, birznieks; import hashlib;"
-            "ds = simulate(sample_population('fingertip', rng=0).select(range(0, 955, 5)), birznieks(30.0),"
+            "ds = simulate(sample_population('fingertip', rng=0).select(range(0, 991, 5)), birznieks(30.0),"
             " engine='direct', seed=3, quiet=True);"
             "print(hashlib.sha256(ds.spike_time.values.tobytes() + ds.spike_afferent.values.tobytes()).hexdigest())")
     outs = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,

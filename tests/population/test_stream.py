@@ -14,7 +14,7 @@ N = 3000
 
 @pytest.fixture(scope="module")
 def setup():
-    pop = sample_population("fingertip", rng=0).select(np.arange(0, 955, 7))
+    pop = sample_population("fingertip", rng=0).select(np.arange(0, 991, 7))
     ppl = press_push_lift(90.0)
     scene = Scene(ppl.fx[4000:4000 + N], ppl.fy[4000:4000 + N], ppl.fz[4000:4000 + N], 1000.0, "x")
     forces = np.column_stack([scene.fx, scene.fy, scene.fz])
