@@ -373,7 +373,7 @@ def load_spec(source) -> PopulationSpec:
     Examples
     --------
     >>> load_spec("fingertip").n_afferents()
-    {'SAI': 282, 'RAI': 573, 'RAII': 100}
+    {'SAI': 282, 'RAI': 573, 'RAII': 100, 'SAII': 36}
     """
     if isinstance(source, PopulationSpec):
         return source

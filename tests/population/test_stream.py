@@ -87,5 +87,5 @@ def test_cli_stream(capsys, monkeypatch):
     assert main(["stream", "--fs", "1000", "--seed", "2"]) == 0
     out, err = capsys.readouterr()
     rows = [r.split(",") for r in out.strip().splitlines()]
-    assert len(rows) > 50 and {r[2] for r in rows} <= {"SAI", "RAI", "RAII"}
+    assert len(rows) > 50 and {r[2] for r in rows} <= {"SAI", "RAI", "RAII", "SAII"}
     assert "line 302 skipped" in err and "line 303 skipped" in err
