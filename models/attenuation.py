@@ -169,7 +169,11 @@ def _factor(fx, fy, theta, profile, k, f_th, mode):
     rad = np.deg2rad(theta)
     params = (prof.p1, prof.p2, prof.p3, prof.p4, prof.p5)
     profile_af = af_core(ux, uy, np.cos(rad), np.sin(rad), k, params, tip_radius(prof))[inverse]
-    af[active] = blend_no_shear(profile_af, mag[active], f_th) if mode == "smooth" else profile_af
+    if mode == "smooth":
+        profile_af = blend_no_shear(profile_af, mag[active], f_th)
+    if active.all():  # the usual case: no masked copy
+        return profile_af
+    af[active] = profile_af
     return af
 
 
@@ -191,7 +195,10 @@ def transition_weight(f_s, f_th: float = F_TH) -> np.ndarray:
 def blend_no_shear(profile_af, f_s, f_th: float = F_TH) -> np.ndarray:
     """AF of the "smooth" reading from the profile's AF (rows: samples) and F_S (N)."""
     w = transition_weight(f_s, f_th)
-    return 1.0 + w[:, None] * (profile_af - 1.0)
+    out = np.subtract(profile_af, 1.0)
+    out *= w[:, None]
+    out += 1.0  # = 1 + w (AF - 1), in place: the population's largest temporary
+    return out
 
 
 def stretch_drive(fx, fy, af, opponent: float = 0.0) -> np.ndarray:

@@ -130,6 +130,10 @@ class CurrentParams:
         Ours: RA-II's low-pass before d^2/dt^2 in Hz (None: ``cutoff_hz``).
     order_raii : int or None
         Ours: order of RA-II's low-pass (None: ``filter_order``).
+    highpass_raii_hz : float or None
+        Ours: cut-off in Hz of a 2nd-order high-pass before RA-II's d^2/dt^2,
+        the Pacinian capsule's mechanical filtering of slow indentation
+        (None: none).
     adapt_sai : float
         Ours: depth of SA-I's slow adaptation (dimensionless, 0: none).
     tau_adapt_sai_s : float
@@ -174,6 +178,7 @@ class CurrentParams:
     cutoff_rai_hz: float | None = None
     cutoff_raii_hz: float | None = None
     order_raii: int | None = None
+    highpass_raii_hz: float | None = None
     adapt_sai: float = 0.0
     tau_adapt_sai_s: float = 1.0
     adapt_rai: float = 0.0
@@ -198,7 +203,7 @@ class CurrentParams:
             check_positive(getattr(self, name), name)
         _optional_positive(self, ("i_sat", "i_sat_sai", "i_sat_rai", "i_sat_raii", "i_max_sai", "i_max_rai",
                                   "i_max_raii", "i_max_saii"), "mV/ms")
-        _optional_positive(self, ("cutoff_sai_hz", "cutoff_rai_hz", "cutoff_raii_hz"), "Hz")
+        _optional_positive(self, ("cutoff_sai_hz", "cutoff_rai_hz", "cutoff_raii_hz", "highpass_raii_hz"), "Hz")
         _optional_positive(self, ("tau_sai_s", "tau_rai_s", "tau_raii_s", "tau_saii_s"), "s")
         for name in ("filter_order", "order_raii"):
             value = getattr(self, name)
@@ -236,7 +241,8 @@ class CurrentParams:
                      self.tau_adapt_rai_s if afferent_type == "RAI" else self.tau_adapt_sai_s,
                      self.gain(afferent_type), self.saturation(afferent_type), i_max,
                      self.bias_saii if afferent_type == "SAII" else 0.0, tau,
-                     self.threshold_rai if afferent_type == "RAI" else 0.0)
+                     self.threshold_rai if afferent_type == "RAI" else 0.0,
+                     self.highpass_raii_hz if afferent_type == "RAII" else None)
 
 
 @dataclass(frozen=True)
@@ -264,6 +270,8 @@ class Stage:
         Time constant of the current's low-pass in s.
     threshold : float
         Dead zone of the rectified drive (RA-I's velocity threshold, N/s).
+    highpass_hz : float or None
+        Cut-off of a 2nd-order high-pass in the filter cascade (RA-II), Hz.
     """
 
     afferent_type: str
@@ -278,6 +286,7 @@ class Stage:
     bias: float
     tau_s: float | None = None
     threshold: float = 0.0
+    highpass_hz: float | None = None
 
     @property
     def signed(self) -> bool:
@@ -368,7 +377,17 @@ def _stage_sos(stage: Stage, fs: float) -> np.ndarray:
         return _PASS_THROUGH
     if not stage.cutoff_hz < fs / 2.0:
         lowpass_sos(stage.cutoff_hz, stage.order, fs)  # raises with the Nyquist message
-    return _butter_sos(float(stage.cutoff_hz), int(stage.order), float(fs))
+    sos = _butter_sos(float(stage.cutoff_hz), int(stage.order), float(fs))
+    if stage.highpass_hz is not None:
+        sos = np.vstack([_highpass_sos(float(stage.highpass_hz), float(fs)), sos])
+    return sos
+
+
+@lru_cache(maxsize=16)
+def _highpass_sos(cutoff_hz: float, fs: float) -> np.ndarray:
+    from scipy import signal
+
+    return signal.butter(2, cutoff_hz, btype="high", fs=fs, output="sos")
 
 
 def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams(), afferent_type: str = "RAI"
@@ -517,9 +536,10 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
 
     ``normals`` (shape (n_afferents, n_samples), standard normal draws) and
     ``noise_cv`` (sqrt(ms), per afferent) add the receptor noise of the
-    module docstring; without them the current is noise-free.
+    module docstring; without them the current is noise-free.  Every stage
+    after the paper's unfiltered SAI runs in one numba pass (`_stage_kernel`).
     """
-    stage = params.stage(afferent_type)
+    stage, sos, alpha_adapt, alpha_smooth = _stage_constants(params, afferent_type, float(fs))
     gain = stage.gain
     if scale is not None:
         gain = gain * np.asarray(scale, dtype=float)
@@ -529,50 +549,116 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
         return _transduce(_receptor_noise(drive, normals, noise_cv, fs) if noisy else drive, stage), None
     if state is None:
         state = initial_filter_state(f_a[0], fs, params, afferent_type)
-    x, new_state = _run_kernel(f_a, fs, stage, state)
-    if stage.derivative == 0:
-        x = x + state.offset
-    if stage.derivative == 0 and stage.adapt > 0.0:
-        x = np.maximum(x, 0.0)  # adaptation undershoots on release: a rate cannot go negative
-    if stage.derivative > 0 and (stage.adapt > 0.0 or stage.threshold > 0.0):
-        x, new_state = _adapt_rectified(np.abs(x), fs, stage, new_state)
-    drive = gain * (x if stage.signed else np.abs(x))
-    if noisy:
-        drive = _receptor_noise(drive, normals, noise_cv, fs, stage.signed)
-    current = np.sign(drive) * _transduce(np.abs(drive), stage) if stage.signed else _transduce(drive, stage)
+    m = f_a.shape[1]
+    zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
+    slow = np.zeros(m) if state.slow is None else state.slow.copy()
+    smooth = np.zeros(m) if state.smooth is None else state.smooth.copy()
+    gain = np.full(m, gain) if np.ndim(gain) == 0 else np.ascontiguousarray(gain, dtype=float)
+    cv_scale = (np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs)) if noisy else gain
+    drive = _stage_kernel(
+        sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, float(fs), stage.derivative,
+        float(stage.adapt), alpha_adapt, float(stage.threshold), gain,
+        np.ascontiguousarray(normals) if noisy else _NO_NORMALS, np.ascontiguousarray(cv_scale), noisy,
+        stage.signed)
+    current = _transduce_inplace(drive, stage)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
     if stage.tau_s is not None:
-        smooth = np.zeros(current.shape[1]) if new_state.smooth is None else new_state.smooth.copy()
-        current = _smooth_kernel(np.ascontiguousarray(current), smooth, float(-np.expm1(-1.0 / (fs * stage.tau_s))))
-        new_state = FilterState(new_state.zi, new_state.offset, new_state.y1, new_state.y2, new_state.slow, smooth)
+        current = _smooth_kernel(current, smooth, alpha_smooth)
     if stage.bias != 0.0:
-        current = current + stage.bias
-    return current, new_state
+        current += stage.bias
+    return current, FilterState(zi, state.offset, y1, y2, slow, smooth)
 
 
-def _adapt_rectified(a, fs, stage, state):
-    """``max(a - adapt * LP(a) - threshold, 0)``, low-pass state in ``state.slow`` (RA-I's adaptation)."""
-    slow = np.zeros(a.shape[1]) if state.slow is None else state.slow.copy()
-    low = _smooth_kernel(np.ascontiguousarray(a), slow, float(-np.expm1(-1.0 / (fs * stage.tau_adapt_s))))
-    new_state = FilterState(state.zi, state.offset, state.y1, state.y2, slow, state.smooth)
-    return np.maximum((a - stage.adapt * low) - stage.threshold, 0.0), new_state
+_NO_NORMALS = np.zeros((1, 0))
 
 
-def _receptor_noise(drive, normals, noise_cv, fs, signed=False):
-    """``d (1 + cv xi / sqrt(h))``, before the transducer; a rectified (unsigned) drive stays >= 0."""
-    scale = np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs)
-    noisy = drive + drive * (normals.T * scale)
-    return noisy if signed else np.maximum(noisy, 0.0)
+@lru_cache(maxsize=256)
+def _stage_constants(params: CurrentParams, afferent_type: str, fs: float):
+    """(stage, filter sections, adaptation and smoothing coefficients): per call they would cost the
+    streaming encoder more than its 1 ms chunk of arithmetic."""
+    stage = params.stage(afferent_type)
+    alpha_adapt = float(-np.expm1(-1.0 / (fs * stage.tau_adapt_s)))
+    alpha_smooth = 0.0 if stage.tau_s is None else float(-np.expm1(-1.0 / (fs * stage.tau_s)))
+    return stage, _stage_sos(stage, fs), alpha_adapt, alpha_smooth
+
+
+@nb.njit(cache=True, nogil=True)
+def _stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_adapt, threshold, gain,
+                  normals, cv_scale, noisy, signed):
+    """The linear part of a type's stage in one pass: the drive d, per sample and afferent.
+
+    Filter (direct form II transposed on the deviation from ``offset``), the
+    derivative of ``order``, adaptation, gain and receptor noise (rectified
+    unless ``signed``).  The state arrays are updated in place.
+    """
+    out = np.empty_like(f_a)
+    fs2 = fs * fs
+    for n in range(f_a.shape[0]):
+        for j in range(f_a.shape[1]):
+            cur = f_a[n, j] - offset[j]
+            for s in range(sos.shape[0]):
+                new = sos[s, 0] * cur + zi[s, 0, j]
+                zi[s, 0, j] = sos[s, 1] * cur - sos[s, 4] * new + zi[s, 1, j]
+                zi[s, 1, j] = sos[s, 2] * cur - sos[s, 5] * new
+                cur = new
+            if order == 0:
+                x = cur
+                if adapt > 0.0:
+                    x = cur + adapt * (cur - slow[j])
+                    slow[j] = slow[j] + alpha_adapt * (cur - slow[j])
+                x = x + offset[j]
+                if adapt > 0.0 and x < 0.0:
+                    x = 0.0  # adaptation undershoots on release: a rate cannot go negative
+            elif order == 1:
+                x = (cur - y1[j]) * fs
+            else:
+                x = ((cur - 2.0 * y1[j]) + y2[j]) * fs2
+            y2[j] = y1[j]
+            y1[j] = cur
+            if order > 0 and (adapt > 0.0 or threshold > 0.0):
+                a = abs(x)
+                slow[j] = slow[j] + alpha_adapt * (a - slow[j])
+                x = max((a - adapt * slow[j]) - threshold, 0.0)
+            d = gain[j] * (x if signed else abs(x))
+            if noisy:
+                d = d + d * (normals[j, n] * cv_scale[j])
+                if not signed and d < 0.0:
+                    d = 0.0
+            out[n, j] = d
+    return out
 
 
 @nb.njit(cache=True, nogil=True)
 def _smooth_kernel(x, c, alpha):
-    """First-order low-pass along axis 0 with state ``c`` (updated in place)."""
-    out = np.empty_like(x)
+    """First-order low-pass along axis 0, in place on ``x``, with state ``c`` (updated)."""
     for n in range(x.shape[0]):
         for j in range(x.shape[1]):
             c[j] = c[j] + alpha * (x[n, j] - c[j])
-            out[n, j] = c[j]
-    return out
+            x[n, j] = c[j]
+    return x
+
+
+def _transduce_inplace(drive, stage: Stage):
+    """`_transduce` on ``|drive|`` in place, the sign restored for SA-II's signed drive."""
+    negative = np.signbit(drive) if stage.signed else None
+    if stage.signed:
+        np.abs(drive, out=drive)
+    if stage.i_sat is not None:
+        drive /= stage.i_sat
+        np.log1p(drive, out=drive)
+        drive *= stage.i_sat
+    if stage.i_max is not None:
+        drive /= stage.i_max
+        np.tanh(drive, out=drive)
+        drive *= stage.i_max
+    if negative is not None:
+        np.negative(drive, out=drive, where=negative)
+    return drive
+
+
+def _receptor_noise(drive, normals, noise_cv, fs):
+    """``d (1 + cv xi / sqrt(h))`` on the paper's unfiltered SAI drive, rectified."""
+    scale = np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs)
+    return np.maximum(drive + drive * (normals.T * scale), 0.0)
 
 
 def _transduce(drive, stage: Stage):

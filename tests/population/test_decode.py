@@ -72,9 +72,13 @@ def test_real_spikes_decode():
                             for i, d in enumerate(rng.uniform(0, 360, n))]
     train = simulate(pop, scenes(60, "a"), engine="direct", seed=1, quiet=True)
     test = simulate(pop, scenes(30, "b"), engine="direct", seed=2, quiet=True)
-    for cls in (MaximumLikelihood, FirstSpikeLatency, PopulationVector):
+    # Achieved (seed 3, 330 afferents, 60 training directions): ML 1.1 deg, latency 0.86 deg, population
+    # vector 2.4 deg (its known bias over non-uniform preferred directions).  The bounds sit about 2x above,
+    # a margin for the noise of 30 test directions, and far below the 7.1 deg of human discrimination.
+    bounds = {MaximumLikelihood: 2.5, FirstSpikeLatency: 2.0, PopulationVector: 5.0}
+    for cls, bound in bounds.items():
         err = angular_error(cls(0.125).fit(train).predict(test).values.ravel(), test.theta_r.values)
-        assert np.median(err) < 20.0, cls.name
+        assert np.median(err) < bound, cls.name
 
 
 def test_bad_input(train, test_set):
