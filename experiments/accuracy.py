@@ -154,3 +154,30 @@ def tolerance_table(result: dict, engine: str = "direct") -> list:
     keep = ("dt_ms", "method", "sf_err_mean", "sf_err_max", "wall_s_per_afferent_s")
     return [{**{k: r[k] for k in keep}, "evals_per_ms": STAGES[r["method"]] / r["dt_ms"]}
             for r in result["rows"] if r["engine"] == engine and r["sf_err_mean"] is not None]
+
+
+def unseen_workload_check(tolerances=(0.3, 0.5, 1.0, 2.0, 5.0)) -> list:
+    """``simulate(tolerance=...)`` on two workloads the table never saw, against the reference.
+
+    Rotating shear from 30 and 200 deg (seed 3, every 5th afferent) and press-push-lift at
+    theta_R = 60 deg (seed 4, every 40th).  Returns one row per tolerance: the choice and the
+    mean SF error (pulses/s) on each workload.
+    """
+    from population import press_push_lift, rotating_shear
+    from population.accuracy import choose_setting
+
+    rot = workload("fingertip", seed=3, directions=(30.0, 200.0),
+                   scene=lambda d: dataclasses.replace(rotating_shear(start_deg=d), name=f"rot{d:g}"))
+    ppl = workload("fingertip", seed=4, directions=(60.0,),
+                   scene=lambda d: dataclasses.replace(press_push_lift(d), name=f"ppl{d:g}"))
+    cases = [(rot[0].select(np.arange(0, len(rot[0]), 5)), rot[1]), (ppl[0].select(np.arange(0, len(ppl[0]), 40)), ppl[1])]
+    cases = [(pop, scenes, reference_times(pop, scenes)) for pop, scenes in cases]
+    rows = []
+    for tol in tolerances:
+        choice = choose_setting(tol, 1000.0)
+        errs = [_compare(_run_times(simulate(pop, scenes, engine="direct", tolerance=tol, seed=0, quiet=True,
+                                             record=("spikes",)), len(pop)), ref, pop, scenes)["sf_err_mean"]
+                for pop, scenes, ref in cases]
+        rows.append({"tolerance": tol, "method": choice["method"], "dt_ms": choice["dt_ms"],
+                     "rotating_shear": errs[0], "press_push_lift": errs[1]})
+    return rows

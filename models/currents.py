@@ -405,53 +405,6 @@ def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams(),
                        slow=zeros.copy(), smooth=zeros.copy())
 
 
-@nb.njit(cache=True, nogil=True)
-def _derivative_kernel(sos, f_a, offset, zi, y1, y2, fs, order, slow, adapt, alpha):
-    """Filter the deviation from ``offset`` (direct form II transposed, SciPy's
-    ``sosfilt`` arithmetic) and return it (order 0) or its backward difference
-    ``(y - y1) fs`` (order 1) or ``(y - 2 y1 + y2) fs^2`` (order 2), in one pass.
-
-    With ``adapt > 0`` (order 0), ``adapt * (y - slow)`` is added, where
-    ``slow`` follows y through a first-order low-pass of coefficient
-    ``alpha``.  ``zi`` (sections, 2, channels), ``y1``, ``y2`` and ``slow``
-    carry the state and are updated in place.
-    """
-    out = np.empty_like(f_a)
-    fs2 = fs * fs
-    for n in range(f_a.shape[0]):
-        for j in range(f_a.shape[1]):
-            cur = f_a[n, j] - offset[j]
-            for s in range(sos.shape[0]):
-                new = sos[s, 0] * cur + zi[s, 0, j]
-                zi[s, 0, j] = sos[s, 1] * cur - sos[s, 4] * new + zi[s, 1, j]
-                zi[s, 1, j] = sos[s, 2] * cur - sos[s, 5] * new
-                cur = new
-            if order == 0:
-                if adapt > 0.0:
-                    out[n, j] = cur + adapt * (cur - slow[j])
-                    slow[j] = slow[j] + alpha * (cur - slow[j])
-                else:
-                    out[n, j] = cur
-            elif order == 1:
-                out[n, j] = (cur - y1[j]) * fs
-            else:
-                out[n, j] = ((cur - 2.0 * y1[j]) + y2[j]) * fs2
-            y2[j] = y1[j]
-            y1[j] = cur
-    return out
-
-
-def _run_kernel(f_a, fs, stage: Stage, state: FilterState):
-    """`_derivative_kernel` on copies of the state; returns (output, new state)."""
-    sos = _stage_sos(stage, fs)
-    zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
-    slow = np.zeros_like(y1) if state.slow is None else state.slow.copy()
-    alpha = -np.expm1(-1.0 / (fs * stage.tau_adapt_s))
-    out = _derivative_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, float(fs),
-                             stage.derivative, slow, float(stage.adapt), float(alpha))
-    return out, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2, slow=slow, smooth=state.smooth)
-
-
 def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=None):
     """Causally low-pass F_A along time (axis 0) with the shared filter (``cutoff_hz``).
 
@@ -478,8 +431,13 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
     shared = Stage("RAI", 0, params.cutoff_hz, params.filter_order, 0.0, 1.0, 1.0, None, None, 0.0)
     if state is None:
         state = initial_filter_state(f_a[0], fs, params)
-    dev, new_state = _run_kernel(f_a, fs, shared, state)
-    return dev + state.offset, new_state
+    m = f_a.shape[1]
+    zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
+    slow = np.zeros(m)
+    # The stage kernel with order 0, unit gain and a signed drive returns exactly deviation + offset.
+    y = _stage_kernel(_stage_sos(shared, float(fs)), np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow,
+                      float(fs), 0, 0.0, 0.0, 0.0, np.ones(m), _NO_NORMALS, np.ones(m), False, True)
+    return y, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2, slow=slow, smooth=state.smooth)
 
 
 def afferent_current(

@@ -20,7 +20,7 @@ Protocols (forces in N, +Z into the skin; the frame of `population.scenes`):
 * ``direction``: the Birznieks protocol (`population.tuning`).
 * ``timing``: first-spike-latency and count (maximum-likelihood) decoders of
   direction in 125 ms, each on ensembles of 92 SA-I, SA-II and FA-I afferents
-  (the size of Saal et al. 2009's sample), median over 5 ensembles; and the
+  (the size of Saal et al. 2009's sample), median over 10 ensembles; and the
   first-spike jitter of FA-I over 10 trials.
 * ``continuity``: F_A across a shear that reverses through zero: the largest
   sample-to-sample step at 10 kHz over that at 1 kHz (0.1 for a continuous
