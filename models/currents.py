@@ -74,6 +74,7 @@ __all__ = [
     "filter_force",
     "afferent_current",
     "current_core",
+    "StagePlan",
     "check_fs",
 ]
 
@@ -490,40 +491,72 @@ def afferent_current(
 
 
 def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals=None, noise_cv=None):
-    """`afferent_current` without validation (the hot path of `simulate` and the streaming encoder).
+    """`afferent_current` without validation (the hot path of `simulate`).
 
     ``normals`` (shape (n_afferents, n_samples), standard normal draws) and
     ``noise_cv`` (sqrt(ms), per afferent) add the receptor noise of the
     module docstring; without them the current is noise-free.  Every stage
-    after the paper's unfiltered SAI runs in one numba pass (`_stage_kernel`).
+    after the paper's unfiltered SAI runs in one numba pass (`_stage_kernel`)
+    and numpy's vectorised transducers.
     """
-    stage, sos, alpha_adapt, alpha_smooth = _stage_constants(params, afferent_type, float(fs))
-    gain = stage.gain
-    if scale is not None:
-        gain = gain * np.asarray(scale, dtype=float)
-    noisy = normals is not None and noise_cv is not None and np.any(np.asarray(noise_cv) > 0)
-    if stage.derivative == 0 and stage.cutoff_hz is None and stage.adapt == 0.0 and stage.tau_s is None:
-        drive = gain * np.abs(f_a)  # the paper's eq. 1, no filter
-        return _transduce(_receptor_noise(drive, normals, noise_cv, fs) if noisy else drive, stage), None
-    if state is None:
-        state = initial_filter_state(f_a[0], fs, params, afferent_type)
-    m = f_a.shape[1]
-    zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
-    slow = np.zeros(m) if state.slow is None else state.slow.copy()
-    smooth = np.zeros(m) if state.smooth is None else state.smooth.copy()
-    gain = np.full(m, gain) if np.ndim(gain) == 0 else np.ascontiguousarray(gain, dtype=float)
-    cv_scale = (np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs)) if noisy else gain
-    drive = _stage_kernel(
-        sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, float(fs), stage.derivative,
-        float(stage.adapt), alpha_adapt, float(stage.threshold), gain,
-        np.ascontiguousarray(normals) if noisy else _NO_NORMALS, np.ascontiguousarray(cv_scale), noisy,
-        stage.signed)
-    current = _transduce_inplace(drive, stage)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
-    if stage.tau_s is not None:
-        current = _smooth_kernel(current, smooth, alpha_smooth)
-    if stage.bias != 0.0:
-        current += stage.bias
-    return current, FilterState(zi, state.offset, y1, y2, slow, smooth)
+    return StagePlan(params, afferent_type, fs, scale, noise_cv).run(f_a, state, normals)
+
+
+class StagePlan:
+    """One type's stage with every per-call constant computed once (`current_core` made reusable).
+
+    The streaming encoder keeps one plan per afferent group and calls `run`
+    once per chunk, where per-call set-up would cost more than the chunk's
+    arithmetic; `current_core` builds one per call, so both run the same code.
+
+    Parameters
+    ----------
+    params : CurrentParams
+    afferent_type : str
+    fs : float
+        Sample rate in Hz.
+    scale : array_like, shape (n_afferents,), optional
+        Per-afferent multiplier of the drive.
+    noise_cv : array_like, shape (n_afferents,), optional
+        Receptor-noise intensity in sqrt(ms).
+    """
+
+    def __init__(self, params, afferent_type, fs, scale=None, noise_cv=None):
+        self.params, self.afferent_type, self.fs = params, afferent_type, float(fs)
+        self.stage, self.sos, self.alpha_adapt, self.alpha_smooth = _stage_constants(params, afferent_type, self.fs)
+        gain = self.stage.gain
+        self.gain = gain if scale is None else gain * np.asarray(scale, dtype=float)
+        self.noise_cv = noise_cv
+        self.noisy = noise_cv is not None and bool(np.any(np.asarray(noise_cv) > 0))
+        self.cv_scale = (np.ascontiguousarray(np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / self.fs))
+                         if self.noisy else None)
+        st = self.stage
+        self.paper_sai = st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
+
+    def run(self, f_a, state=None, normals=None):
+        """Currents (mV/ms) of a chunk and the state after it; ``normals`` shape (n_afferents, n_samples)."""
+        st, noisy = self.stage, self.noisy and normals is not None
+        if self.paper_sai:
+            drive = self.gain * np.abs(f_a)  # the paper's eq. 1, no filter
+            return _transduce(_receptor_noise(drive, normals, self.noise_cv, self.fs) if noisy else drive, st), None
+        if state is None:
+            state = initial_filter_state(f_a[0], self.fs, self.params, self.afferent_type)
+        m = f_a.shape[1]
+        zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
+        slow = np.zeros(m) if state.slow is None else state.slow.copy()
+        smooth = np.zeros(m) if state.smooth is None else state.smooth.copy()
+        gain = self.gain if np.ndim(self.gain) else np.full(m, self.gain)
+        drive = _stage_kernel(
+            self.sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, self.fs, st.derivative,
+            float(st.adapt), self.alpha_adapt, float(st.threshold), gain,
+            np.ascontiguousarray(normals) if noisy else _NO_NORMALS, self.cv_scale if noisy else gain, noisy,
+            st.signed)
+        current = _transduce_inplace(drive, st)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
+        if st.tau_s is not None:
+            current = _smooth_kernel(current, smooth, self.alpha_smooth)
+        if st.bias != 0.0:
+            current += st.bias
+        return current, FilterState(zi, state.offset, y1, y2, slow, smooth)
 
 
 _NO_NORMALS = np.zeros((1, 0))

@@ -22,7 +22,7 @@ import numpy as np
 
 from models._validation import as_finite_array, check_choice, check_positive
 from models.attenuation import F_TH, NO_SHEAR_READINGS, UNTUNED, _af_kernel, blend_no_shear, stretch_drive
-from models.currents import check_fs, current_core
+from models.currents import StagePlan, check_fs
 from models.direct import _BLOCK, _METHOD_CODES, _integrate_range
 from models.engines import (ENGINES, METHODS, NeuronState, check_integration, check_stability, integrate, prepare,
                             substeps_for)
@@ -133,6 +133,11 @@ class Encoder:
         self._press_tuned = np.flatnonzero(~stretch[self._tuned])  # positions within the tuned afferents
         self._stretch = np.flatnonzero(stretch)
         self._stretch_tuned = stretch[self._tuned]  # which tuned afferents are SA-II
+        self._press_tuned_cols = self._tuned[self._press_tuned]
+        self._stretch_tuned_cols = np.flatnonzero(pop.nap[self._stretch] != UNTUNED)
+        self._plans = [StagePlan(pop.current, kind, self.fs, self._scale[cols], pop.noise_cv[cols])
+                       for kind, cols in self._groups]
+        self._additive = bool(np.any(pop.noise_sigma > 0))
         self._neuron_params = neuron_arrays(pop.afferent_type)
         self._h, self._half = 1.0 * self.dt / 0.001, (1.0 * (0.5 * self.dt)) / 0.001  # as run_direct computes them
 
@@ -247,37 +252,44 @@ class Encoder:
         return StreamSpikes(afferent, step * self.dt)
 
     def _currents(self, forces, filters, normals=None) -> np.ndarray:
-        """Currents of a chunk: the offline arithmetic (`af_core`, `current_core`) without its checks."""
+        """Currents of a chunk: the offline arithmetic (`af_core`, the stage plans) without its checks."""
         fx, fy, fz = forces[:, 0], forces[:, 1], forces[:, 2]
-        n, n_aff = forces.shape[0], len(self._pop)
-        drive = np.empty((n, n_aff))
+        n = forces.shape[0]
+        drive = np.empty((n, len(self._pop)))
         drive[:, self._press_untuned] = fz[:, None]
         mag = np.hypot(fx, fy)
-        profile = np.ones((n, self._tuned.size))
-        sheared = mag > 0.0
-        if self._tuned.size and sheared.any():
-            ux, uy = fx[sheared] / mag[sheared], fy[sheared] / mag[sheared]
-            profile[sheared] = _af_kernel(ux, uy, *self._af_args)  # af_core's kernel
+        if self._tuned.size:
+            profile = np.ones((n, self._tuned.size))
+            sheared = mag > 0.0
+            if sheared.all():
+                profile = _af_kernel(fx / mag, fy / mag, *self._af_args)  # af_core's kernel
+            elif sheared.any():
+                profile[sheared] = _af_kernel(fx[sheared] / mag[sheared], fy[sheared] / mag[sheared], *self._af_args)
+            self._press_drive(drive, profile, mag, fz)
+            if self._stretch.size:
+                af_stretch = np.ones((n, self._stretch.size))
+                af_stretch[:, self._stretch_tuned_cols] = profile[:, self._stretch_tuned]
+                drive[:, self._stretch] = stretch_drive(fx, fy, af_stretch, self._pop.current.opponent_saii)
+        elif self._stretch.size:
+            drive[:, self._stretch] = stretch_drive(fx, fy, np.ones((n, self._stretch.size)),
+                                                    self._pop.current.opponent_saii)
+        current = np.empty_like(drive)
+        for i, ((_, cols), plan) in enumerate(zip(self._groups, self._plans)):
+            current[:, cols], filters[i] = plan.run(drive[:, cols], filters.get(i),
+                                                    None if normals is None else normals[cols])
+        if normals is not None and self._additive:
+            current += noise_current(normals, self._pop.noise_sigma, self.fs)
+        return current
+
+    def _press_drive(self, drive, profile, mag, fz) -> None:
+        """F_A of the tuned, pressure-driven afferents into ``drive``, under the encoder's no-shear reading."""
         press = profile[:, self._press_tuned]
         if self.no_shear == "smooth":
             af = blend_no_shear(press, mag, F_TH)
         else:
             af = np.where((mag > F_TH)[:, None], press, 1.0 if self.no_shear == "pass" else 0.0)
-        drive[:, self._tuned[self._press_tuned]] = af * fz[:, None]
-        if self._stretch.size:
-            af_stretch = np.ones((n, self._stretch.size))
-            tuned_cols = np.flatnonzero(self._pop.nap[self._stretch] != UNTUNED)
-            af_stretch[:, tuned_cols] = profile[:, self._stretch_tuned]
-            drive[:, self._stretch] = stretch_drive(fx, fy, af_stretch, self._pop.current.opponent_saii)
-        current = np.empty_like(drive)
-        pop = self._pop
-        for i, (kind, cols) in enumerate(self._groups):
-            current[:, cols], filters[i] = current_core(drive[:, cols], self.fs, kind, pop.current, filters.get(i),
-                                                        self._scale[cols], None if normals is None else normals[cols],
-                                                        pop.noise_cv[cols])
-        if normals is not None and np.any(pop.noise_sigma > 0):
-            current += noise_current(normals, pop.noise_sigma, self.fs)
-        return current
+        af *= fz[:, None]
+        drive[:, self._press_tuned_cols] = af
 
     def _integrate(self, current):
         """Advance the neurons; the direct engine is called without the seam's per-call set-up."""
