@@ -58,9 +58,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 
-import numba as nb
 import numpy as np
 
+from ._stage_kernels import smooth_kernel, stage_kernel, transduce_inplace
 from ._validation import as_finite_array, check_choice, check_positive
 
 __all__ = [
@@ -436,7 +436,7 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
     zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
     slow = np.zeros(m)
     # The stage kernel with order 0, unit gain and a signed drive returns exactly deviation + offset.
-    y = _stage_kernel(_stage_sos(shared, float(fs)), np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow,
+    y = stage_kernel(_stage_sos(shared, float(fs)), np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow,
                       float(fs), 0, 0.0, 0.0, 0.0, np.ones(m), _NO_NORMALS, np.ones(m), False, True)
     return y, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2, slow=slow, smooth=state.smooth)
 
@@ -496,7 +496,7 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     ``normals`` (shape (n_afferents, n_samples), standard normal draws) and
     ``noise_cv`` (sqrt(ms), per afferent) add the receptor noise of the
     module docstring; without them the current is noise-free.  Every stage
-    after the paper's unfiltered SAI runs in one numba pass (`_stage_kernel`)
+    after the paper's unfiltered SAI runs in one numba pass (`models._stage_kernels.stage_kernel`)
     and numpy's vectorised transducers.
     """
     return StagePlan(params, afferent_type, fs, scale, noise_cv).run(f_a, state, normals)
@@ -546,14 +546,14 @@ class StagePlan:
         slow = np.zeros(m) if state.slow is None else state.slow.copy()
         smooth = np.zeros(m) if state.smooth is None else state.smooth.copy()
         gain = self.gain if np.ndim(self.gain) else np.full(m, self.gain)
-        drive = _stage_kernel(
+        drive = stage_kernel(
             self.sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, self.fs, st.derivative,
             float(st.adapt), self.alpha_adapt, float(st.threshold), gain,
             np.ascontiguousarray(normals) if noisy else _NO_NORMALS, self.cv_scale if noisy else gain, noisy,
             st.signed)
-        current = _transduce_inplace(drive, st)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
+        current = transduce_inplace(drive, st)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
         if st.tau_s is not None:
-            current = _smooth_kernel(current, smooth, self.alpha_smooth)
+            current = smooth_kernel(current, smooth, self.alpha_smooth)
         if st.bias != 0.0:
             current += st.bias
         return current, FilterState(zi, state.offset, y1, y2, slow, smooth)
@@ -570,80 +570,6 @@ def _stage_constants(params: CurrentParams, afferent_type: str, fs: float):
     alpha_adapt = float(-np.expm1(-1.0 / (fs * stage.tau_adapt_s)))
     alpha_smooth = 0.0 if stage.tau_s is None else float(-np.expm1(-1.0 / (fs * stage.tau_s)))
     return stage, _stage_sos(stage, fs), alpha_adapt, alpha_smooth
-
-
-@nb.njit(cache=True, nogil=True)
-def _stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_adapt, threshold, gain,
-                  normals, cv_scale, noisy, signed):
-    """The linear part of a type's stage in one pass: the drive d, per sample and afferent.
-
-    Filter (direct form II transposed on the deviation from ``offset``), the
-    derivative of ``order``, adaptation, gain and receptor noise (rectified
-    unless ``signed``).  The state arrays are updated in place.
-    """
-    out = np.empty_like(f_a)
-    fs2 = fs * fs
-    for n in range(f_a.shape[0]):
-        for j in range(f_a.shape[1]):
-            cur = f_a[n, j] - offset[j]
-            for s in range(sos.shape[0]):
-                new = sos[s, 0] * cur + zi[s, 0, j]
-                zi[s, 0, j] = sos[s, 1] * cur - sos[s, 4] * new + zi[s, 1, j]
-                zi[s, 1, j] = sos[s, 2] * cur - sos[s, 5] * new
-                cur = new
-            if order == 0:
-                x = cur
-                if adapt > 0.0:
-                    x = cur + adapt * (cur - slow[j])
-                    slow[j] = slow[j] + alpha_adapt * (cur - slow[j])
-                x = x + offset[j]
-                if adapt > 0.0 and x < 0.0:
-                    x = 0.0  # adaptation undershoots on release: a rate cannot go negative
-            elif order == 1:
-                x = (cur - y1[j]) * fs
-            else:
-                x = ((cur - 2.0 * y1[j]) + y2[j]) * fs2
-            y2[j] = y1[j]
-            y1[j] = cur
-            if order > 0 and (adapt > 0.0 or threshold > 0.0):
-                a = abs(x)
-                slow[j] = slow[j] + alpha_adapt * (a - slow[j])
-                x = max((a - adapt * slow[j]) - threshold, 0.0)
-            d = gain[j] * (x if signed else abs(x))
-            if noisy:
-                d = d + d * (normals[j, n] * cv_scale[j])
-                if not signed and d < 0.0:
-                    d = 0.0
-            out[n, j] = d
-    return out
-
-
-@nb.njit(cache=True, nogil=True)
-def _smooth_kernel(x, c, alpha):
-    """First-order low-pass along axis 0, in place on ``x``, with state ``c`` (updated)."""
-    for n in range(x.shape[0]):
-        for j in range(x.shape[1]):
-            c[j] = c[j] + alpha * (x[n, j] - c[j])
-            x[n, j] = c[j]
-    return x
-
-
-def _transduce_inplace(drive, stage: Stage):
-    """`_transduce` on ``|drive|`` in place, the sign restored for SA-II's signed drive."""
-    negative = np.signbit(drive) if stage.signed else None
-    if stage.signed:
-        np.abs(drive, out=drive)
-    if stage.i_sat is not None:
-        drive /= stage.i_sat
-        np.log1p(drive, out=drive)
-        drive *= stage.i_sat
-    if stage.i_max is not None:
-        drive /= stage.i_max
-        np.tanh(drive, out=drive)
-        drive *= stage.i_max
-    if negative is not None:
-        np.negative(drive, out=drive, where=negative)
-    return drive
 
 
 def _receptor_noise(drive, normals, noise_cv, fs):

@@ -126,12 +126,11 @@ PROPERTIES = dict([
 PROTOCOLS = ("rest", "on_off", "rates", "force_coding", "frequency", "direction", "timing", "continuity")
 
 
-def _knots(knots, values, *, fs=1000.0, name="scene", stages=(), shear=None) -> Scene:
+def _knots(knots, values, *, fs=1000.0, name="scene", stages=()) -> Scene:
+    """A normal-force scene through (time, force) knots, no shear."""
     t = np.arange(int(round(knots[-1] * fs))) / fs
     fz = np.interp(t, knots, values)
-    fx = np.zeros_like(fz) if shear is None else shear[0](t)
-    fy = np.zeros_like(fz) if shear is None else shear[1](t)
-    return Scene(fx, fy, fz, fs, name, tuple(stages))
+    return Scene(np.zeros_like(fz), np.zeros_like(fz), fz, fs, name, tuple(stages))
 
 
 def on_off_scene() -> Scene:
