@@ -120,7 +120,7 @@ def _objective(theta, spec, kind, seeds):
     return misfit + 1e3 * constraint_penalty(trial_spec, kind)
 
 
-def _unpack(theta, kind, spec=None):
+def _unpack(theta, kind):
     untuned = float(np.clip(theta[0], 0.0, 0.6))
     bipolar = float(np.clip(theta[1], 0.0, 0.9))
     if kind == "SAI":

@@ -217,33 +217,36 @@ class CurrentParams:
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
 
+    def _own(self, prefix: str, afferent_type: str, suffix: str = "", default=None):
+        """The per-type field ``<prefix>_<type><suffix>`` (e.g. ``i_max_raii``), or ``default`` if it has none."""
+        return getattr(self, f"{prefix}_{afferent_type.lower()}{suffix}", default)
+
     def gain(self, afferent_type: str) -> float:
         """The gain of ``afferent_type`` (``"SAI"``, ``"RAI"``, ``"RAII"`` or ``"SAII"``)."""
         check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
-        return {"SAI": self.g_sai, "RAI": self.g_rai, "RAII": self.g_raii, "SAII": self.g_saii}[afferent_type]
+        return self._own("g", afferent_type)
 
     def saturation(self, afferent_type: str) -> float | None:
-        """The log-compression scale of ``afferent_type`` in mV/ms (None: linear)."""
-        own = {"SAI": self.i_sat_sai, "RAI": self.i_sat_rai, "RAII": self.i_sat_raii, "SAII": None}[afferent_type]
-        return self.i_sat if own is None and afferent_type != "SAII" else own
+        """The log-compression scale of ``afferent_type`` in mV/ms (None: linear; SA-II has none)."""
+        if afferent_type == "SAII":
+            return None
+        own = self._own("i_sat", afferent_type)
+        return self.i_sat if own is None else own
 
     def stage(self, afferent_type: str) -> "Stage":
         """The resolved stage of one type: filter, derivative order, transducer."""
         check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
-        cutoff = {"SAI": self.cutoff_sai_hz, "RAI": self.cutoff_rai_hz or self.cutoff_hz,
-                  "RAII": self.cutoff_raii_hz or self.cutoff_hz, "SAII": self.cutoff_saii_hz}[afferent_type]
+        cutoff = self._own("cutoff", afferent_type, "_hz")
+        if afferent_type in ("RAI", "RAII"):
+            cutoff = cutoff or self.cutoff_hz  # the paper's shared low-pass before the derivatives
         order = self.order_raii if afferent_type == "RAII" and self.order_raii is not None else self.filter_order
-        i_max = {"SAI": self.i_max_sai, "RAI": self.i_max_rai, "RAII": self.i_max_raii,
-                 "SAII": self.i_max_saii}[afferent_type]
-        tau = {"SAI": self.tau_sai_s, "RAI": self.tau_rai_s, "RAII": self.tau_raii_s,
-               "SAII": self.tau_saii_s}[afferent_type]
+        tau_adapt = self._own("tau_adapt", afferent_type, "_s", self.tau_adapt_sai_s)
         return Stage(afferent_type, DERIVATIVE_ORDER[afferent_type], cutoff, order,
-                     {"SAI": self.adapt_sai, "RAI": self.adapt_rai}.get(afferent_type, 0.0),
-                     self.tau_adapt_rai_s if afferent_type == "RAI" else self.tau_adapt_sai_s,
-                     self.gain(afferent_type), self.saturation(afferent_type), i_max,
-                     self.bias_saii if afferent_type == "SAII" else 0.0, tau,
-                     self.threshold_rai if afferent_type == "RAI" else 0.0,
-                     self.highpass_raii_hz if afferent_type == "RAII" else None)
+                     self._own("adapt", afferent_type, default=0.0), tau_adapt, self.gain(afferent_type),
+                     self.saturation(afferent_type), self._own("i_max", afferent_type),
+                     self._own("bias", afferent_type, default=0.0), self._own("tau", afferent_type, "_s"),
+                     self._own("threshold", afferent_type, default=0.0),
+                     self._own("highpass", afferent_type, "_hz"))
 
 
 @dataclass(frozen=True)
@@ -538,7 +541,7 @@ class StagePlan:
         st, noisy = self.stage, self.noisy and normals is not None
         if self.paper_sai:
             drive = self.gain * np.abs(f_a)  # the paper's eq. 1, no filter
-            return _transduce(_receptor_noise(drive, normals, self.noise_cv, self.fs) if noisy else drive, st), None
+            return transduce_inplace(_receptor_noise(drive, normals, self.noise_cv, self.fs) if noisy else drive, st), None
         if state is None:
             state = initial_filter_state(f_a[0], self.fs, self.params, self.afferent_type)
         m = f_a.shape[1]
@@ -576,12 +579,3 @@ def _receptor_noise(drive, normals, noise_cv, fs):
     """``d (1 + cv xi / sqrt(h))`` on the paper's unfiltered SAI drive, rectified."""
     scale = np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs)
     return np.maximum(drive + drive * (normals.T * scale), 0.0)
-
-
-def _transduce(drive, stage: Stage):
-    """Log compression and/or saturation of the linear drive (see the module docstring)."""
-    if stage.i_sat is not None:
-        drive = stage.i_sat * np.log1p(drive / stage.i_sat)
-    if stage.i_max is not None:
-        drive = stage.i_max * np.tanh(drive / stage.i_max)
-    return drive
