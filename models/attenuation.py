@@ -218,17 +218,25 @@ def stretch_drive(fx, fy, af, opponent: float = 0.0) -> np.ndarray:
     return f_s[:, None] * (af - opponent * (1.0 - af))
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def profile_value(ux, uy, cos_t, sin_t, k, p1, p2, p3, p4, p5, tip):
+    """One afferent's profile AF for the unit shear vector (ux, uy): the scalar `_af_kernel` and the
+    fused streaming kernel share."""
+    cos_phi = ux * cos_t + uy * sin_t
+    sin_phi = uy * cos_t - ux * sin_t
+    r = radius_scalar(sin_phi, cos_phi, k, p1, p2, p3, p4, p5) / tip
+    # For k < 1 (theta_A > 90 deg with b = 1) a profile is wider than its
+    # tip is long, so r(phi) > r(0) off-axis; AF saturates at 1.
+    return min(r, 1.0)
+
+
 @nb.njit(cache=True, nogil=True)
 def _af_kernel(ux, uy, cos_t, sin_t, k, p1, p2, p3, p4, p5, tip):
     out = np.empty((ux.size, cos_t.size))
     for i in range(ux.size):
         for j in range(cos_t.size):
-            cos_phi = ux[i] * cos_t[j] + uy[i] * sin_t[j]
-            sin_phi = uy[i] * cos_t[j] - ux[i] * sin_t[j]
-            r = radius_scalar(sin_phi, cos_phi, k[j], p1[j], p2[j], p3[j], p4[j], p5[j]) / tip[j]
-            # For k < 1 (theta_A > 90 deg with b = 1) a profile is wider than its
-            # tip is long, so r(phi) > r(0) off-axis; AF saturates at 1.
-            out[i, j] = min(r, 1.0)
+            out[i, j] = profile_value(ux[i], uy[i], cos_t[j], sin_t[j], k[j], p1[j], p2[j], p3[j], p4[j], p5[j],
+                                      tip[j])
     return out
 
 

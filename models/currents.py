@@ -74,7 +74,6 @@ __all__ = [
     "filter_force",
     "afferent_current",
     "current_core",
-    "StagePlan",
     "check_fs",
 ]
 
@@ -499,67 +498,35 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     ``normals`` (shape (n_afferents, n_samples), standard normal draws) and
     ``noise_cv`` (sqrt(ms), per afferent) add the receptor noise of the
     module docstring; without them the current is noise-free.  Every stage
-    after the paper's unfiltered SAI runs in one numba pass (`models._stage_kernels.stage_kernel`)
-    and numpy's vectorised transducers.
+    after the paper's unfiltered SAI runs in one numba pass
+    (`models._stage_kernels.stage_kernel`) and numpy's vectorised
+    transducers; `models.fused` runs the same arithmetic for the streaming
+    encoder.
     """
-    return StagePlan(params, afferent_type, fs, scale, noise_cv).run(f_a, state, normals)
-
-
-class StagePlan:
-    """One type's stage with every per-call constant computed once (`current_core` made reusable).
-
-    The streaming encoder keeps one plan per afferent group and calls `run`
-    once per chunk, where per-call set-up would cost more than the chunk's
-    arithmetic; `current_core` builds one per call, so both run the same code.
-
-    Parameters
-    ----------
-    params : CurrentParams
-    afferent_type : str
-    fs : float
-        Sample rate in Hz.
-    scale : array_like, shape (n_afferents,), optional
-        Per-afferent multiplier of the drive.
-    noise_cv : array_like, shape (n_afferents,), optional
-        Receptor-noise intensity in sqrt(ms).
-    """
-
-    def __init__(self, params, afferent_type, fs, scale=None, noise_cv=None):
-        self.params, self.afferent_type, self.fs = params, afferent_type, float(fs)
-        self.stage, self.sos, self.alpha_adapt, self.alpha_smooth = _stage_constants(params, afferent_type, self.fs)
-        gain = self.stage.gain
-        self.gain = gain if scale is None else gain * np.asarray(scale, dtype=float)
-        self.noise_cv = noise_cv
-        self.noisy = noise_cv is not None and bool(np.any(np.asarray(noise_cv) > 0))
-        self.cv_scale = (np.ascontiguousarray(np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / self.fs))
-                         if self.noisy else None)
-        st = self.stage
-        self.paper_sai = st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
-
-    def run(self, f_a, state=None, normals=None):
-        """Currents (mV/ms) of a chunk and the state after it; ``normals`` shape (n_afferents, n_samples)."""
-        st, noisy = self.stage, self.noisy and normals is not None
-        if self.paper_sai:
-            drive = self.gain * np.abs(f_a)  # the paper's eq. 1, no filter
-            return transduce_inplace(_receptor_noise(drive, normals, self.noise_cv, self.fs) if noisy else drive, st), None
-        if state is None:
-            state = initial_filter_state(f_a[0], self.fs, self.params, self.afferent_type)
-        m = f_a.shape[1]
-        zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
-        slow = np.zeros(m) if state.slow is None else state.slow.copy()
-        smooth = np.zeros(m) if state.smooth is None else state.smooth.copy()
-        gain = self.gain if np.ndim(self.gain) else np.full(m, self.gain)
-        drive = stage_kernel(
-            self.sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, self.fs, st.derivative,
-            float(st.adapt), self.alpha_adapt, float(st.threshold), gain,
-            np.ascontiguousarray(normals) if noisy else _NO_NORMALS, self.cv_scale if noisy else gain, noisy,
-            st.signed)
-        current = transduce_inplace(drive, st)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
-        if st.tau_s is not None:
-            current = smooth_kernel(current, smooth, self.alpha_smooth)
-        if st.bias != 0.0:
-            current += st.bias
-        return current, FilterState(zi, state.offset, y1, y2, slow, smooth)
+    fs = float(fs)
+    st, sos, alpha_adapt, alpha_smooth = _stage_constants(params, afferent_type, fs)
+    gain = st.gain if scale is None else st.gain * np.asarray(scale, dtype=float)
+    noisy = normals is not None and noise_cv is not None and bool(np.any(np.asarray(noise_cv) > 0))
+    if st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None:
+        drive = gain * np.abs(f_a)  # the paper's eq. 1, no filter
+        return transduce_inplace(_receptor_noise(drive, normals, noise_cv, fs) if noisy else drive, st), None
+    if state is None:
+        state = initial_filter_state(f_a[0], fs, params, afferent_type)
+    m = f_a.shape[1]
+    zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
+    slow = np.zeros(m) if state.slow is None else state.slow.copy()
+    smooth = np.zeros(m) if state.smooth is None else state.smooth.copy()
+    gain = gain if np.ndim(gain) else np.full(m, gain)
+    cv_scale = np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs) if noisy else gain
+    drive = stage_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, fs, st.derivative,
+                         float(st.adapt), alpha_adapt, float(st.threshold), gain,
+                         np.ascontiguousarray(normals) if noisy else _NO_NORMALS, cv_scale, noisy, st.signed)
+    current = transduce_inplace(drive, st)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
+    if st.tau_s is not None:
+        current = smooth_kernel(current, smooth, alpha_smooth)
+    if st.bias != 0.0:
+        current += st.bias
+    return current, FilterState(zi, state.offset, y1, y2, slow, smooth)
 
 
 _NO_NORMALS = np.zeros((1, 0))
@@ -567,8 +534,8 @@ _NO_NORMALS = np.zeros((1, 0))
 
 @lru_cache(maxsize=256)
 def _stage_constants(params: CurrentParams, afferent_type: str, fs: float):
-    """(stage, filter sections, adaptation and smoothing coefficients): per call they would cost the
-    streaming encoder more than its 1 ms chunk of arithmetic."""
+    """(stage, filter sections, adaptation and smoothing coefficients), cached: per call they would
+    cost a short chunk more than its arithmetic."""
     stage = params.stage(afferent_type)
     alpha_adapt = float(-np.expm1(-1.0 / (fs * stage.tau_adapt_s)))
     alpha_smooth = 0.0 if stage.tau_s is None else float(-np.expm1(-1.0 / (fs * stage.tau_s)))

@@ -6,6 +6,10 @@ the filter is causal and every stage carries its state, the concatenated
 spikes of *any* chunking equal the offline `simulate` run of the whole
 signal with the same seed (condition 0, trial 0), bit for bit.
 
+Each chunk runs through `models.fused.FusedPlan`: two numba passes (force
+to linear drive, then current to spikes) around numpy's transducers, with
+the same arithmetic as the offline stage-by-stage path.
+
 Noise is drawn ahead in blocks (``noise_block`` samples per afferent) from
 the same per-afferent streams as offline, on a background thread while the
 previous block is consumed, so a chunk only slices a ready block and drawing
@@ -21,18 +25,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from models._validation import as_finite_array, check_choice, check_positive
-from models.attenuation import F_TH, NO_SHEAR_READINGS, UNTUNED, _af_kernel, blend_no_shear, stretch_drive
-from models.currents import StagePlan, check_fs
-from models.direct import _BLOCK, _METHOD_CODES, _integrate_range
+from models.attenuation import F_TH, NO_SHEAR_READINGS
+from models.currents import check_fs
+from models.direct import _BLOCK, _METHOD_CODES
 from models.engines import (ENGINES, METHODS, NeuronState, check_integration, check_stability, integrate, prepare,
                             substeps_for)
-from models.nap import get_profile, tip_radius
+from models.fused import FusedPlan
 from models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
 
-from .noise import draw_noise, noise_current, noise_streams, root_seed
+from .noise import draw_noise, noise_streams, root_seed
 from .sampling import Population
 from .scenes import Contact
-from .simulate import _grouped, _runs
+from .simulate import _grouped
 
 __all__ = ["StreamSpikes", "Encoder"]
 
@@ -109,44 +113,27 @@ class Encoder:
         self.reset()
 
     def _precompute(self) -> None:
-        """Per-afferent constants of the fast path (same values the offline path uses)."""
+        """The fused plan's tables (the same values the offline path uses) and the integrator's constants."""
         pop = self._pop
-        self._tuned = np.flatnonzero(pop.nap != UNTUNED)
-        rad = np.deg2rad(pop.theta_t[self._tuned])
-        self._cos_t, self._sin_t = np.cos(rad), np.sin(rad)
-        profiles = [get_profile(n) for n in pop.nap[self._tuned]]
-        self._params = tuple(np.array([getattr(p, f) for p in profiles]) for f in ("p1", "p2", "p3", "p4", "p5"))
-        tips = {name: tip_radius(name) for name in set(pop.nap[self._tuned].tolist())}
-        self._tip = np.array([tips[n] for n in pop.nap[self._tuned]])
-        self._k = pop.k[self._tuned]
-        self._af_args = tuple(np.ascontiguousarray(x, dtype=float) for x in
-                              (self._cos_t, self._sin_t, self._k, *self._params, self._tip))
-        weights = None
+        scale = pop.gain
         if self.contact is not None:
             from .spatial import receptive_field_weight
 
-            weights = receptive_field_weight(pop.x_mm, pop.y_mm, pop.afferent_type, self.contact)
-        self._scale = pop.gain if weights is None else pop.gain * weights
-        self._groups = [(kind, cols) for kind, cols in _runs(pop.afferent_type)]
-        stretch = pop.afferent_type == "SAII"
-        self._press_untuned = np.flatnonzero(~stretch & (pop.nap == UNTUNED))
-        self._press_tuned = np.flatnonzero(~stretch[self._tuned])  # positions within the tuned afferents
-        self._stretch = np.flatnonzero(stretch)
-        self._stretch_tuned = stretch[self._tuned]  # which tuned afferents are SA-II
-        self._press_tuned_cols = self._tuned[self._press_tuned]
-        self._stretch_tuned_cols = np.flatnonzero(pop.nap[self._stretch] != UNTUNED)
-        self._plans = [StagePlan(pop.current, kind, self.fs, self._scale[cols], pop.noise_cv[cols])
-                       for kind, cols in self._groups]
-        self._additive = bool(np.any(pop.noise_sigma > 0))
-        self._neuron_params = neuron_arrays(pop.afferent_type)
-        self._h, self._half = 1.0 * self.dt / 0.001, (1.0 * (0.5 * self.dt)) / 0.001  # as run_direct computes them
+            scale = pop.gain * receptive_field_weight(pop.x_mm, pop.y_mm, pop.afferent_type, self.contact)
+        self._plan = FusedPlan(pop.afferent_type, pop.nap, pop.theta_t, pop.k, scale, pop.noise_cv, pop.noise_sigma,
+                               pop.current, self.fs, self.no_shear, F_TH)
+        p = neuron_arrays(pop.afferent_type)
+        h, half = 1.0 * self.dt / 0.001, (1.0 * (0.5 * self.dt)) / 0.001  # as run_direct computes them
+        self._neuron_args = (self.substeps, _METHOD_CODES[self.method], h, half, p["a"], p["b"], p["c"], p["d"],
+                             V_PEAK, V_FLOOR, _BLOCK)
+        self._b = p["b"]
 
     def reset(self) -> None:
         """Back to the start: filters unset, neurons at rest, noise streams rewound."""
         if getattr(self, "_pending", None) is not None:
             self._pending.result()  # let an in-flight draw finish before its streams are dropped
         self._pending = None
-        self._filters, self._neuron, self._samples, self._last_time = {}, None, 0, None
+        self._state, self._neuron, self._samples, self._last_time = self._plan.new_state(), None, 0, None
         noisy = np.any(self._pop.noise_sigma > 0) or np.any(self._pop.noise_cv > 0)
         self._streams = noise_streams(self.seed, 0, 0, self._pop.afferent_id) if noisy else None
         self._blocks = deque()  # noise drawn ahead, oldest first; rows before _noise_pos are used
@@ -234,12 +221,11 @@ class Encoder:
         n = forces.shape[0]
         if n == 0:
             return StreamSpikes(np.empty(0, np.int64), np.empty(0))
-        filters = dict(self._filters)  # committed only if the whole chunk succeeds
+        state = self._state.copy()  # committed only if the whole chunk succeeds
         normals = None if self._streams is None else self._peek_noise(n).T
-        current = self._currents(forces, filters, normals)
-        afferent, step, v, u = self._integrate(current)
+        afferent, step, v, u = self._run(forces, normals, state)
         step0 = self._samples * self.substeps
-        self._filters, self._neuron = filters, NeuronState(v, u)
+        self._state, self._neuron = state, NeuronState(v, u)
         if self._streams is not None:
             self._consume_noise(n)
         self._samples += n
@@ -251,60 +237,22 @@ class Encoder:
             afferent, step = afferent[order], step[order]
         return StreamSpikes(afferent, step * self.dt)
 
-    def _currents(self, forces, filters, normals=None) -> np.ndarray:
-        """Currents of a chunk: the offline arithmetic (`af_core`, the stage plans) without its checks."""
-        fx, fy, fz = forces[:, 0], forces[:, 1], forces[:, 2]
-        n = forces.shape[0]
-        drive = np.empty((n, len(self._pop)))
-        drive[:, self._press_untuned] = fz[:, None]
-        mag = np.hypot(fx, fy)
-        if self._tuned.size:
-            profile = np.ones((n, self._tuned.size))
-            sheared = mag > 0.0
-            if sheared.all():
-                profile = _af_kernel(fx / mag, fy / mag, *self._af_args)  # af_core's kernel
-            elif sheared.any():
-                profile[sheared] = _af_kernel(fx[sheared] / mag[sheared], fy[sheared] / mag[sheared], *self._af_args)
-            self._press_drive(drive, profile, mag, fz)
-            if self._stretch.size:
-                af_stretch = np.ones((n, self._stretch.size))
-                af_stretch[:, self._stretch_tuned_cols] = profile[:, self._stretch_tuned]
-                drive[:, self._stretch] = stretch_drive(fx, fy, af_stretch, self._pop.current.opponent_saii)
-        elif self._stretch.size:
-            drive[:, self._stretch] = stretch_drive(fx, fy, np.ones((n, self._stretch.size)),
-                                                    self._pop.current.opponent_saii)
-        current = np.empty_like(drive)
-        for i, ((_, cols), plan) in enumerate(zip(self._groups, self._plans)):
-            current[:, cols], filters[i] = plan.run(drive[:, cols], filters.get(i),
-                                                    None if normals is None else normals[cols])
-        if normals is not None and self._additive:
-            current += noise_current(normals, self._pop.noise_sigma, self.fs)
-        return current
-
-    def _press_drive(self, drive, profile, mag, fz) -> None:
-        """F_A of the tuned, pressure-driven afferents into ``drive``, under the encoder's no-shear reading."""
-        press = profile[:, self._press_tuned]
-        if self.no_shear == "smooth":
-            af = blend_no_shear(press, mag, F_TH)
-        else:
-            af = np.where((mag > F_TH)[:, None], press, 1.0 if self.no_shear == "pass" else 0.0)
-        af *= fz[:, None]
-        drive[:, self._press_tuned_cols] = af
-
-    def _integrate(self, current):
-        """Advance the neurons; the direct engine is called without the seam's per-call set-up."""
-        if self.engine != "direct":
-            res = integrate(current, fs=self.fs, dt=self.dt, afferent_type=self._pop.afferent_type,
-                            engine=self.engine, method=self.method, state=self._neuron)
-            return res.afferent, res.step, res.state.v, res.state.u
+    def _run(self, forces, normals, state):
+        """The fused plan on a chunk: spikes and the neurons' new state (the seam's checks, without its set-up)."""
+        started = self._samples > 0
         if self._neuron is None:
-            v, u = (np.array(x, dtype=float) for x in resting_state(self._neuron_params["b"]))
+            v, u = (np.array(x, dtype=float) for x in resting_state(self._b))
         else:
             v, u = self._neuron.v.copy(), self._neuron.u.copy()
-        check_stability(current, self.dt, self.method)
-        p = self._neuron_params
-        afferent, step = _integrate_range(np.ascontiguousarray(current), self.substeps, _METHOD_CODES[self.method],
-                                          self._h, self._half, p["a"], p["b"], p["c"], p["d"], v, u, V_PEAK, V_FLOOR,
-                                          _BLOCK, 0, v.size)
-        check_integration(afferent, step, v, u, current, self.method, self.dt)
+        if self.engine != "direct":
+            current = self._plan.currents(forces, normals, state, started)
+            res = integrate(current, fs=self.fs, dt=self.dt, afferent_type=self._pop.afferent_type,
+                            engine=self.engine, method=self.method, state=NeuronState(v, u))
+            return res.afferent, res.step, res.state.v, res.state.u
+        current, afferent, step, lowest, finite = self._plan.spikes(forces, normals, state, started,
+                                                                    self._neuron_args, v, u)
+        if self.method != "euler":
+            check_stability(np.array([lowest]), self.dt, self.method)
+        if not finite or afferent.size > 1:
+            check_integration(afferent, step, v, u, current, self.method, self.dt)
         return afferent, step, v, u

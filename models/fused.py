@@ -1,0 +1,260 @@
+"""The pipeline from force to spikes fused into two numba passes over samples (the streaming hot path).
+
+The per-stage functions (`models.attenuation`, `models.currents`,
+`models.engines`) stay the definition of the model.  `FusedPlan` runs the
+same arithmetic, sample by sample, with every per-call constant packed once
+into tables:
+
+1. **front** (one numba pass): shear magnitude and direction, each
+   afferent's profile AF (`attenuation.profile_value`), the no-shear
+   reading, F_A or SA-II's stretch drive, then the type's linear stage
+   (`_stage_kernels.filter_sections` and `stage_tail`: filter, derivative,
+   adaptation, gain, receptor noise);
+2. **transducers**: numpy's vectorised log1p/tanh on each type's columns (a
+   scalar libm call in numba would differ in the last bit from numpy's SIMD
+   ones, and is several times slower);
+3. **back** (one numba pass): the current's low-pass, the bias and the
+   additive noise, then the direct engine's integrator.
+
+Because the scalar helpers are the very functions the per-stage kernels
+call, and every operation keeps their order, the result is bit-identical to
+the stage-by-stage path (``tests/population/test_stream.py`` holds the
+streaming encoder, which runs on this, to the offline `simulate`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from ._stage_kernels import filter_sections, stage_tail, transduce_inplace
+from .attenuation import UNTUNED, profile_value
+from .currents import _stage_constants
+from .direct import _integrate_range
+from .nap import get_profile, tip_radius
+
+__all__ = ["FusedPlan"]
+
+# Rows of the per-afferent float table.
+_COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA = range(12)
+# Rows of the per-afferent integer table.
+_GROUP, _TUNED = range(2)
+# Rows of the per-group float and integer tables.
+_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS = range(5)
+_NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = range(9)
+# Rows of the state after the 2 * n_sections filter rows.
+_OFFSET, _Y1, _Y2, _SLOW, _SMOOTH = range(5)
+
+_NO_NORMALS = np.zeros((0, 1)).T  # same layout as a transposed noise block
+
+
+@nb.njit(cache=True, nogil=True)
+def _front(forces, normals, noisy_any, state, started, aff_f, aff_i, grp_f, grp_i, sos, fs, smooth_reading,
+           outside_value, f_th, opponent):
+    """Force (n, 3) to linear drive (n, n_afferents); ``state`` updated in place.
+
+    Groups (runs of one type and NAP) are the outer loop, so each inner loop
+    over afferents has loop-invariant constants and branches.
+    """
+    n, m, rows = forces.shape[0], aff_i.shape[1], 2 * sos.shape[1]
+    z, offset = state[:rows], state[rows + _OFFSET]
+    y1, y2, slow = state[rows + _Y1], state[rows + _Y2], state[rows + _SLOW]
+    out, f = np.empty((n, m)), np.empty(m)
+    gain, cv_scale, two_fth = aff_f[_GAIN], aff_f[_CV], 2.0 * f_th
+    for i in range(n):
+        fx, fy, fz = forces[i, 0], forces[i, 1], forces[i, 2]
+        mag = math.hypot(fx, fy)
+        ux, uy = (fx / mag, fy / mag) if mag > 0.0 else (0.0, 0.0)
+        x = min(max(mag / two_fth, 0.0), 1.0)
+        w = x * x * (3.0 - 2.0 * x)  # `transition_weight`
+        for g in range(grp_i.shape[1]):
+            lo, hi = grp_i[_START, g], grp_i[_STOP, g]
+            tuned, stretch = grp_i[_TUNED_G, g] != 0, grp_i[_SIGNED, g] != 0
+            for j in range(lo, hi):
+                p = 1.0
+                if tuned and mag > 0.0:
+                    p = profile_value(ux, uy, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j], aff_f[_P1, j],
+                                      aff_f[_P2, j], aff_f[_P3, j], aff_f[_P4, j], aff_f[_P5, j], aff_f[_TIP, j])
+                if stretch:
+                    f[j] = mag * (p - opponent * (1.0 - p))  # `stretch_drive`
+                elif tuned:
+                    af = ((p - 1.0) * w) + 1.0 if smooth_reading else (p if mag > f_th else outside_value)
+                    f[j] = af * fz
+                else:
+                    f[j] = fz
+            if i == 0 and not started and grp_i[_PLAIN, g] == 0:
+                offset[lo:hi] = f[lo:hi]  # `initial_filter_state`: at rest on the first sample
+            for j in range(lo, hi):
+                f[j] = f[j] - offset[j]
+            filter_sections(f, lo, hi, sos, g, grp_i[_NSEC, g], z)
+            stage_tail(f, lo, hi, offset, y1, y2, slow, fs, grp_i[_ORDER, g], grp_f[_ADAPT, g],
+                       grp_f[_ALPHA_ADAPT, g], grp_f[_THRESHOLD, g], gain, normals, i, cv_scale,
+                       noisy_any and grp_i[_NOISY, g] != 0, grp_i[_SIGNED, g] != 0)
+        out[i] = f
+    return out
+
+
+@nb.njit(cache=True, nogil=True)
+def _back(current, normals, additive, state, rows, aff_f, aff_i, grp_f, grp_i):
+    """Low-pass, bias and additive noise of the transduced drive, in place; returns the smallest current."""
+    smooth = state[rows + _SMOOTH]
+    lowest = np.inf
+    for i in range(current.shape[0]):
+        for j in range(current.shape[1]):
+            g, x = aff_i[_GROUP, j], current[i, j]
+            if grp_i[_SMOOTHED, g] != 0:
+                smooth[j] = smooth[j] + grp_f[_ALPHA_SMOOTH, g] * (x - smooth[j])  # `smooth_kernel`
+                x = smooth[j]
+            if grp_f[_BIAS, g] != 0.0:
+                x = x + grp_f[_BIAS, g]
+            if additive:
+                x = x + normals[j, i] * aff_f[_SIGMA, j]  # `noise_current`
+            current[i, j] = x
+            lowest = min(lowest, x)
+    return lowest
+
+
+@nb.njit(cache=True, nogil=True)
+def _back_and_integrate(current, normals, additive, state, rows, aff_f, aff_i, grp_f, grp_i, substeps, method, h,
+                        half, a, b, c, d, v, u, v_peak, v_floor, block):
+    """`_back`, then the direct engine on the current; returns spikes, the smallest current and finiteness."""
+    lowest = _back(current, normals, additive, state, rows, aff_f, aff_i, grp_f, grp_i)
+    idx, stp = _integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, 0,
+                                v.size)
+    finite = True
+    for j in range(v.size):
+        if not (math.isfinite(v[j]) and math.isfinite(u[j])):
+            finite = False
+    return idx, stp, lowest, finite
+
+
+class FusedPlan:
+    """Tables of the fused pipeline for one population, ordered so that each type's afferents are contiguous.
+
+    Parameters
+    ----------
+    afferent_type, nap : array_like of str, shape (n_afferents,)
+        Type and NAP per afferent (``"none"`` for untuned).
+    theta_t : array_like of float
+        Tuning angles in degrees.
+    k : array_like of float
+        Sharpness (dimensionless).
+    scale : array_like of float
+        Per-afferent multiplier of the stage gain (population gain times
+        receptive-field weight).
+    noise_cv : array_like of float
+        Receptor-noise intensity in sqrt(ms).
+    noise_sigma : array_like of float
+        Additive-noise intensity in mV/ms * sqrt(ms).
+    params : CurrentParams
+    fs : float
+        Sample rate in Hz.
+    no_shear : {"pass", "block", "smooth"}
+    f_th : float
+        Shear threshold in newtons.
+
+    Examples
+    --------
+    >>> from models.currents import CurrentParams
+    >>> plan = FusedPlan(["SAI"], ["none"], [0.0], [1.0], [1.0], [0.0], [0.0], CurrentParams(), 1000.0, "pass", 0.1)
+    >>> plan.currents(np.array([[0.0, 0.0, 2.0]]), None, plan.new_state(), False).shape
+    (1, 1)
+    """
+
+    def __init__(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, params, fs, no_shear, f_th):
+        afferent_type, nap = np.asarray(afferent_type), np.asarray(nap)
+        self.n_afferents, self.fs, self.f_th = afferent_type.size, float(fs), float(f_th)
+        self.smooth_reading, self.outside_value = no_shear == "smooth", 1.0 if no_shear == "pass" else 0.0
+        self.opponent = float(params.opponent_saii)
+        change = (afferent_type[1:] != afferent_type[:-1]) | ((nap[1:] == UNTUNED) != (nap[:-1] == UNTUNED))
+        bounds = np.flatnonzero(np.r_[True, change, True])  # runs of one type, tuned or not
+        spans = list(zip(bounds[:-1], bounds[1:]))
+        consts = [_stage_constants(params, str(afferent_type[a]), self.fs) for a, _ in spans]
+        noise_cv, noise_sigma = np.asarray(noise_cv, dtype=float), np.asarray(noise_sigma, dtype=float)
+        self.aff_f, self.aff_i = self._afferent_tables(afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma,
+                                                       spans, consts)
+        self.grp_f, self.grp_i, self.sos = self._group_tables(spans, consts, noise_cv, nap != UNTUNED)
+        self.rows = 2 * self.sos.shape[1]
+        self.additive = bool(np.any(noise_sigma > 0))
+        self.transducers = []  # (columns, stage) per run of one type: numpy's calls cost per call
+        for (a, b), (st, *_) in zip(spans, consts):
+            if st.i_sat is None and st.i_max is None and not st.signed:
+                continue
+            if self.transducers and self.transducers[-1][1] is st and self.transducers[-1][0].stop == a:
+                self.transducers[-1] = (slice(self.transducers[-1][0].start, int(b)), st)
+            else:
+                self.transducers.append((slice(int(a), int(b)), st))
+
+    def _afferent_tables(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, spans, consts):
+        n = self.n_afferents
+        aff_f, aff_i = np.zeros((12, n)), np.zeros((2, n), dtype=np.int64)
+        tuned = nap != UNTUNED
+        rad = np.deg2rad(np.asarray(theta_t, dtype=float))
+        aff_f[_COS], aff_f[_SIN], aff_f[_K] = np.cos(rad), np.sin(rad), np.asarray(k, dtype=float)
+        aff_f[_TIP] = 1.0
+        for j in np.flatnonzero(tuned):
+            profile = get_profile(str(nap[j]))
+            aff_f[_P1:_P5 + 1, j] = [profile.p1, profile.p2, profile.p3, profile.p4, profile.p5]
+            aff_f[_TIP, j] = tip_radius(str(nap[j]))
+        scale = np.asarray(scale, dtype=float)
+        for g, ((a, b), (stage, *_)) in enumerate(zip(spans, consts)):
+            aff_i[_GROUP, a:b] = g
+            aff_f[_GAIN, a:b] = stage.gain * scale[a:b]  # as `current_core`
+        aff_f[_CV] = noise_cv / np.sqrt(1000.0 / self.fs)  # as `current_core` and `_receptor_noise`
+        aff_f[_SIGMA] = noise_sigma / np.sqrt(1000.0 / self.fs)  # as `noise_current`
+        aff_i[_TUNED] = tuned
+        return aff_f, aff_i
+
+    def _group_tables(self, spans, consts, noise_cv, tuned):
+        n_groups, n_sec = len(spans), max([sos.shape[0] for _, sos, _, _ in consts] + [1])
+        grp_f, grp_i = np.zeros((5, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
+        sos_all = np.zeros((n_groups, n_sec, 6))
+        for g, ((a, b), (st, sos, alpha_adapt, alpha_smooth)) in enumerate(zip(spans, consts)):
+            sos_all[g, :sos.shape[0]] = sos
+            plain = st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
+            grp_f[:, g] = [st.adapt, alpha_adapt, st.threshold, alpha_smooth, st.bias]
+            grp_i[:, g] = [sos.shape[0], st.derivative, st.signed, plain, np.any(noise_cv[a:b] > 0),
+                           st.tau_s is not None, tuned[a], a, b]
+        return grp_f, grp_i, sos_all
+
+    def new_state(self) -> np.ndarray:
+        """Filter, offset, difference, adaptation and smoothing state at rest, shape (n_rows, n_afferents)."""
+        return np.zeros((self.rows + 5, self.n_afferents))
+
+    def _drive(self, forces, normals, state, started):
+        noisy = normals is not None
+        drive = _front(forces, normals if noisy else _NO_NORMALS, noisy, state, started, self.aff_f, self.aff_i,
+                       self.grp_f, self.grp_i, self.sos, self.fs, self.smooth_reading, self.outside_value, self.f_th,
+                       self.opponent)
+        for cols, stage in self.transducers:
+            transduce_inplace(drive[:, cols], stage)
+        return drive
+
+    def currents(self, forces, normals, state, started):
+        """Currents (mV/ms), shape (n_samples, n_afferents), of forces (n_samples, 3) in newtons.
+
+        ``normals`` (shape (n_afferents, n_samples)) or None; ``state`` is
+        updated in place; ``started`` is False on the first chunk.
+        """
+        current = self._drive(forces, normals, state, started)
+        noisy = normals is not None
+        _back(current, normals if noisy else _NO_NORMALS, noisy and self.additive, state, self.rows, self.aff_f,
+              self.aff_i, self.grp_f, self.grp_i)
+        return current
+
+    def spikes(self, forces, normals, state, started, neuron, v, u):
+        """Currents, then the direct engine: (current, afferent, step, smallest current, finite) of the chunk.
+
+        ``neuron`` is (substeps, method code, h, half, a, b, c, d, v_peak,
+        v_floor, block) as `models.direct` takes them; ``v``, ``u`` and
+        ``state`` are updated in place.
+        """
+        current = self._drive(forces, normals, state, started)
+        noisy = normals is not None
+        substeps, method, h, half, a, b, c, d, v_peak, v_floor, block = neuron
+        out = _back_and_integrate(current, normals if noisy else _NO_NORMALS, noisy and self.additive, state,
+                                  self.rows, self.aff_f, self.aff_i, self.grp_f, self.grp_i, substeps, method, h,
+                                  half, a, b, c, d, v, u, v_peak, v_floor, block)
+        return (current, *out)

@@ -1,0 +1,102 @@
+"""The fused pipeline (`models.fused`) against the per-stage functions it fuses: the same bits."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from models.attenuation import UNTUNED, attenuated_force, attenuation_factor, profile_factor, stretch_drive
+from models.currents import CurrentParams, current_core
+from models.fused import FusedPlan
+from population import load_spec
+
+FS = 1000.0
+PHYSIO = load_spec("fingertip").current
+#: Afferents in runs of one type (as the encoder orders them), tuned and untuned in each.
+TYPES = ["SAI"] * 4 + ["RAI"] * 4 + ["RAII"] * 3 + ["SAII"] * 3
+NAPS = ["selective", "broad", "none", "bipolar", "broad", "none", "selective", "bipolar",
+        "selective", "none", "broad", "broad", "none", "selective"]
+
+
+def forces(seed, n=400):
+    """Press, shear that rotates and crosses F_TH, release: every branch of the drive."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / FS
+    fz = np.clip(3.0 * np.sin(np.pi * t / t[-1]) + 0.05 * rng.standard_normal(n), 0.0, None)
+    shear = np.clip(0.4 * np.sin(2 * np.pi * 3 * t), 0.0, None)
+    angle = rng.uniform(0, 2 * np.pi) + 4.0 * t
+    return np.column_stack([shear * np.cos(angle), shear * np.sin(angle), fz])
+
+
+def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals):
+    """The stage-by-stage path: AF, F_A or stretch, each type's stage, additive noise."""
+    fx, fy, fz = f.T
+    drive = np.empty((f.shape[0], len(TYPES)))
+    for j, (kind, nap) in enumerate(zip(TYPES, NAPS)):
+        if kind == "SAII":
+            af = profile_factor(fx, fy, theta[j], nap, k[j]) if nap != UNTUNED else np.ones((fx.size, 1))
+            drive[:, j] = stretch_drive(fx, fy, af, params.opponent_saii)[:, 0]
+        elif nap == UNTUNED:
+            drive[:, j] = fz
+        else:
+            drive[:, j] = attenuated_force(fz, attenuation_factor(fx, fy, theta[j], nap, k[j],
+                                                                  no_shear=no_shear))[:, 0]
+    current = np.empty_like(drive)
+    for kind in dict.fromkeys(TYPES):
+        cols = np.flatnonzero(np.array(TYPES) == kind)
+        current[:, cols], _ = current_core(drive[:, cols], FS, kind, params, None, scale[cols],
+                                           None if normals is None else normals[cols], cv[cols])
+    if normals is not None and np.any(sigma > 0):
+        current += (normals * (sigma / np.sqrt(1000.0 / FS))[:, None]).T
+    return current
+
+
+@settings(max_examples=12, deadline=None)
+@given(seed=st.integers(0, 2**16), no_shear=st.sampled_from(["pass", "block", "smooth"]),
+       physio=st.booleans(), noisy=st.booleans(), cut=st.integers(1, 399))
+def test_fused_currents_equal_the_stage_by_stage_path(seed, no_shear, physio, noisy, cut):
+    rng = np.random.default_rng(seed)
+    params = PHYSIO if physio else CurrentParams()
+    n = len(TYPES)
+    theta, k, scale = rng.uniform(0, 360, n), rng.uniform(2.0, 5.0, n), rng.uniform(0.5, 2.0, n)
+    cv = np.where(rng.random(n) < 0.7, rng.uniform(0.1, 1.0, n), 0.0)
+    sigma = np.where(np.array(TYPES) == "SAII", 0.5, 0.0)
+    f = forces(seed)
+    normals = rng.standard_normal((n, f.shape[0])) if noisy else None
+    expected = reference(f, params, no_shear, scale, cv, sigma, theta, k, normals)
+    plan = FusedPlan(TYPES, NAPS, theta, k, scale, cv, sigma, params, FS, no_shear, 0.1)
+    state = plan.new_state()
+    parts = [plan.currents(f[a:b], None if normals is None else normals[:, a:b], state, a > 0)
+             for a, b in ((0, cut), (cut, f.shape[0]))]  # in two chunks: the state carries over
+    np.testing.assert_array_equal(np.concatenate(parts), expected)
+
+
+def test_fused_plan_needs_no_tuned_afferent():
+    plan = FusedPlan(["RAI", "RAI"], ["none", "none"], [0.0, 0.0], [3.0, 3.0], [1.0, 1.0], [0.0, 0.0], [0.0, 0.0],
+                     PHYSIO, FS, "smooth", 0.1)
+    f = forces(1)
+    expected, _ = current_core(np.column_stack([f[:, 2], f[:, 2]]), FS, "RAI", PHYSIO, None, np.ones(2))
+    np.testing.assert_array_equal(plan.currents(f, None, plan.new_state(), False), expected)
+
+
+@pytest.mark.parametrize("method", ["euler", "rk4"])
+def test_fused_spikes_equal_the_direct_engine(method):
+    from models.direct import _BLOCK, _METHOD_CODES
+    from models.engines import integrate
+    from models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
+
+    plan = FusedPlan(TYPES, NAPS, np.linspace(0, 330, len(TYPES)), np.full(len(TYPES), 3.0), np.full(len(TYPES), 2.0),
+                     np.zeros(len(TYPES)), np.zeros(len(TYPES)), PHYSIO, FS, "smooth", 0.1)
+    f = forces(2)
+    current = plan.currents(f, None, plan.new_state(), False)
+    res = integrate(current, fs=FS, dt=1e-4, afferent_type=np.array(TYPES), engine="direct", method=method)
+    p = neuron_arrays(np.array(TYPES))
+    v, u = (np.array(x, dtype=float) for x in resting_state(p["b"]))
+    neuron = (10, _METHOD_CODES[method], 1.0 * 1e-4 / 0.001, (1.0 * (0.5 * 1e-4)) / 0.001, p["a"], p["b"], p["c"],
+              p["d"], V_PEAK, V_FLOOR, _BLOCK)
+    _, afferent, step, _, finite = plan.spikes(f, None, plan.new_state(), False, neuron, v, u)
+    assert finite and afferent.size > 10
+    order = np.lexsort((afferent, step))
+    np.testing.assert_array_equal(afferent[order], res.afferent)
+    np.testing.assert_array_equal(step[order], res.step)
+    np.testing.assert_array_equal(v, res.state.v)
