@@ -16,6 +16,8 @@ from models._validation import as_finite_array, check_positive
 __all__ = [
     "DEFAULT_FS",
     "Contact",
+    "Sites",
+    "taxel_radius",
     "Stage",
     "Scene",
     "birznieks",
@@ -42,6 +44,74 @@ class Contact:
             if not np.isfinite(value):
                 raise ValueError(f"contact {name} must be finite, got {value!r}")
         check_positive(self.radius_mm, "contact radius_mm", "mm")
+
+
+@dataclass(frozen=True, eq=False)
+class Sites:
+    """Where a scene's forces act: one footprint per site, in the population's frame.
+
+    Attributes
+    ----------
+    x_mm, y_mm : ndarray, shape (n_sites,)
+        Centre of each site in mm.
+    radius_mm : ndarray, shape (n_sites,)
+        Footprint radius in mm: the contact radius, or for a taxel of pitch
+        p the equal-area radius ``p / sqrt(pi)`` (`taxel_radius`).
+    region : ndarray of str, shape (n_sites,)
+        Region label (e.g. ``"D2d"``), ``""`` when unknown.
+    site_id : ndarray of str, shape (n_sites,)
+        Unique site names.
+    """
+
+    x_mm: np.ndarray
+    y_mm: np.ndarray
+    radius_mm: np.ndarray
+    region: np.ndarray = None
+    site_id: np.ndarray = None
+
+    def __post_init__(self):
+        x = as_finite_array(self.x_mm, "sites x_mm", ndim=1)
+        n = x.size
+        if n == 0:
+            raise ValueError("sites: need at least one site, got 0")
+        y = as_finite_array(self.y_mm, "sites y_mm", ndim=1)
+        r = np.broadcast_to(as_finite_array(self.radius_mm, "sites radius_mm"), (n,)).copy()
+        if y.size != n:
+            raise ValueError(f"sites: x_mm and y_mm must have equal length; got {n} and {y.size}")
+        if np.any(r <= 0):
+            i = int(np.flatnonzero(r <= 0)[0])
+            raise ValueError(f"sites radius_mm must be > 0 mm; got {r[i]!r} at site {i}")
+        region = np.full(n, "", dtype=object) if self.region is None else np.asarray(self.region, dtype=object)
+        ids = np.array([str(i) for i in range(n)], dtype=object) if self.site_id is None else np.asarray(
+            [str(s) for s in self.site_id], dtype=object)
+        for name, arr in (("region", region), ("site_id", ids)):
+            if arr.shape != (n,):
+                raise ValueError(f"sites {name} must have one entry per site ({n}), got shape {arr.shape}")
+        if len(set(ids.tolist())) != n:
+            dup = next(s for s in ids if (ids == s).sum() > 1)
+            raise ValueError(f"sites: duplicate site id {dup!r}")
+        for name, arr in (("x_mm", x), ("y_mm", y), ("radius_mm", r), ("region", region), ("site_id", ids)):
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+
+    def __len__(self) -> int:
+        return self.x_mm.size
+
+    @property
+    def area_mm2(self) -> np.ndarray:
+        """Footprint area of each site in mm^2."""
+        return np.pi * self.radius_mm ** 2
+
+
+def taxel_radius(pitch_mm: float) -> float:
+    """Equal-area footprint radius (mm) of a square taxel of pitch ``pitch_mm``: ``pitch / sqrt(pi)``.
+
+    Examples
+    --------
+    >>> round(taxel_radius(2.5), 4)
+    1.4105
+    """
+    return float(check_positive(pitch_mm, "pitch_mm", "mm") / np.sqrt(np.pi))
 
 
 @dataclass(frozen=True)
@@ -71,6 +141,13 @@ class Scene:
         Where the force is applied; None means no spatial information.
     theta_r : float or None
         Nominal shear direction in degrees, when the scene has one.
+    sites : Sites or None
+        For a multi-site scene (`Scene.from_sites`): where each force acts.
+        None: the one-site scene, whose force ``(fx, fy, fz)`` is the whole
+        contact's.
+    site_forces : ndarray, shape (n_samples, n_sites, 3), or None
+        Force at each site in newtons (F_X, F_Y, F_Z), with ``sites``; then
+        ``fx``, ``fy``, ``fz`` are their sums over sites.
     """
 
     fx: np.ndarray
@@ -81,6 +158,8 @@ class Scene:
     stages: tuple = field(default_factory=tuple)
     contact: Contact | None = None
     theta_r: float | None = None
+    sites: Sites | None = None
+    site_forces: np.ndarray | None = None
 
     def __post_init__(self):
         arrays = [as_finite_array(getattr(self, n), n, ndim=1) for n in ("fx", "fy", "fz")]
@@ -101,6 +180,52 @@ class Scene:
             a.setflags(write=False)
             object.__setattr__(self, n, a)
         object.__setattr__(self, "stages", tuple(self.stages))
+        self._check_sites(arrays[0].size)
+
+    def _check_sites(self, n_samples: int) -> None:
+        if (self.sites is None) != (self.site_forces is None):
+            raise ValueError("sites and site_forces go together: give both (a multi-site scene) or neither")
+        if self.sites is None:
+            return
+        if not isinstance(self.sites, Sites):
+            raise TypeError(f"sites must be a Sites, got {type(self.sites).__name__}")
+        if self.contact is not None:
+            raise ValueError("a multi-site scene has no contact: each site carries its own footprint")
+        forces = as_finite_array(self.site_forces, "site_forces", ndim=3)
+        if forces.shape != (n_samples, len(self.sites), 3):
+            raise ValueError(f"site_forces must have shape (n_samples, n_sites, 3) = ({n_samples}, "
+                             f"{len(self.sites)}, 3), got {forces.shape}")
+        if np.any(forces[:, :, 2] < 0):
+            k, j = np.argwhere(forces[:, :, 2] < 0)[0]
+            raise ValueError(f"site_forces: fz must be >= 0 N; got {forces[k, j, 2]!r} at site "
+                             f"{self.sites.site_id[j]!r}, t = {k / self.fs} s")
+        forces.setflags(write=False)
+        object.__setattr__(self, "site_forces", forces)
+
+    @classmethod
+    def from_sites(cls, forces, sites: Sites, fs: float = DEFAULT_FS, name: str = "scene", stages=(),
+                   theta_r: float | None = None) -> "Scene":
+        """A multi-site scene: ``forces`` (n_samples, n_sites, 3) in newtons at ``sites``.
+
+        ``fx``, ``fy``, ``fz`` become the total force (the sum over sites).
+
+        Examples
+        --------
+        >>> sites = Sites([-3.0, 3.0], [0.0, 0.0], 1.5)
+        >>> s = Scene.from_sites(np.ones((10, 2, 3)), sites, name="two")
+        >>> s.n_sites, float(s.fz[0])
+        (2, 2.0)
+        """
+        forces = as_finite_array(forces, "forces", ndim=3)
+        if forces.ndim != 3 or forces.shape[2] != 3:
+            raise ValueError(f"forces must have shape (n_samples, n_sites, 3), got {forces.shape}")
+        total = forces.sum(axis=1)
+        return cls(total[:, 0], total[:, 1], total[:, 2], fs, name, stages, None, theta_r, sites, forces)
+
+    @property
+    def n_sites(self) -> int:
+        """Number of force sites (1 for a one-site scene)."""
+        return 1 if self.sites is None else len(self.sites)
 
     @property
     def n_samples(self) -> int:
