@@ -35,7 +35,7 @@ from .currents import _stage_constants
 from .direct import _integrate_range
 from .nap import get_profile, tip_radius
 
-__all__ = ["FusedPlan"]
+__all__ = ["FusedPlan", "mix_forces"]
 
 # Rows of the per-afferent float table.
 _COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA = range(12)
@@ -48,42 +48,96 @@ _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = ran
 _OFFSET, _Y1, _Y2, _SLOW, _SMOOTH = range(5)
 
 _NO_NORMALS = np.zeros((0, 1)).T  # same layout as a transposed noise block
+_NO_FORCES, _NO_LOCAL = np.zeros((0, 3)), np.zeros((0, 0, 3))
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _shear(fx, fy, two_fth):
+    """Shear magnitude (N), unit direction and the smooth reading's weight (`transition_weight`)."""
+    mag = math.hypot(fx, fy)
+    ux, uy = (fx / mag, fy / mag) if mag > 0.0 else (0.0, 0.0)
+    x = min(max(mag / two_fth, 0.0), 1.0)
+    return mag, ux, uy, x * x * (3.0 - 2.0 * x)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _drive(aff_f, j, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value, f_th, opponent):
+    """Afferent ``j``'s drive in newtons: F_A = AF F_Z, or SA-II's stretch (`stretch_drive`)."""
+    p = 1.0
+    if tuned and mag > 0.0:
+        p = profile_value(ux, uy, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j], aff_f[_P1, j], aff_f[_P2, j],
+                          aff_f[_P3, j], aff_f[_P4, j], aff_f[_P5, j], aff_f[_TIP, j])
+    if stretch:
+        return mag * (p - opponent * (1.0 - p))
+    if tuned:
+        af = ((p - 1.0) * w) + 1.0 if smooth_reading else (p if mag > f_th else outside_value)
+        return af * fz
+    return fz
 
 
 @nb.njit(cache=True, nogil=True)
-def _front(forces, normals, noisy_any, state, started, aff_f, aff_i, grp_f, grp_i, sos, fs, smooth_reading,
-           outside_value, f_th, opponent):
-    """Force (n, 3) to linear drive (n, n_afferents); ``state`` updated in place.
+def mix_forces(forces, indptr, indices, coeff):
+    """Each afferent's local force, shape (n_samples, n_afferents, 3), from site forces (n_samples, n_sites, 3).
 
-    Groups (runs of one type and NAP) are the outer loop, so each inner loop
-    over afferents has loop-invariant constants and branches.
+    ``F_i = sum_k coeff[k] F[indices[k]]`` over ``k`` in ``indptr[i]:indptr[i + 1]``
+    (`population.spatial.local_mixing`), summed in that fixed order so any
+    chunking of time gives the same bits.
     """
-    n, m, rows = forces.shape[0], aff_i.shape[1], 2 * sos.shape[1]
+    n, m = forces.shape[0], indptr.size - 1
+    out = np.zeros((n, m, 3))
+    for i in range(n):
+        for j in range(m):
+            for k in range(indptr[j], indptr[j + 1]):
+                c, s = coeff[k], indices[k]
+                out[i, j, 0] += c * forces[i, s, 0]
+                out[i, j, 1] += c * forces[i, s, 1]
+                out[i, j, 2] += c * forces[i, s, 2]
+    return out
+
+
+@nb.njit(cache=True, nogil=True)
+def _local_drive(local, aff_f, aff_i, grp_i, smooth_reading, outside_value, f_th, opponent):
+    """Drive (n, n_afferents) from each afferent's own force (n, n_afferents, 3)."""
+    n, m = local.shape[0], local.shape[1]
+    out, two_fth = np.empty((n, m)), 2.0 * f_th
+    for i in range(n):
+        for j in range(m):
+            g = aff_i[_GROUP, j]
+            mag, ux, uy, w = _shear(local[i, j, 0], local[i, j, 1], two_fth)
+            out[i, j] = _drive(aff_f, j, grp_i[_TUNED_G, g] != 0, grp_i[_SIGNED, g] != 0, local[i, j, 2], mag, ux,
+                               uy, w, smooth_reading, outside_value, f_th, opponent)
+    return out
+
+
+@nb.njit(cache=True, nogil=True)
+def _front(forces, local, is_local, normals, noisy_any, state, started, aff_f, aff_i, grp_f, grp_i, sos, fs,
+           smooth_reading, outside_value, f_th, opponent):
+    """Force to linear drive (n, n_afferents); ``state`` updated in place.
+
+    ``forces`` (n, 3) is felt by every afferent, or with ``is_local`` each
+    afferent feels its own ``local`` (n, n_afferents, 3).  Groups (runs of
+    one type, tuned or not) are the outer loop, so each inner loop over
+    afferents has loop-invariant constants and branches.
+    """
+    n, m, rows = forces.shape[0] if not is_local else local.shape[0], aff_i.shape[1], 2 * sos.shape[1]
     z, offset = state[:rows], state[rows + _OFFSET]
     y1, y2, slow = state[rows + _Y1], state[rows + _Y2], state[rows + _SLOW]
     out, f = np.empty((n, m)), np.empty(m)
     gain, cv_scale, two_fth = aff_f[_GAIN], aff_f[_CV], 2.0 * f_th
     for i in range(n):
-        fx, fy, fz = forces[i, 0], forces[i, 1], forces[i, 2]
-        mag = math.hypot(fx, fy)
-        ux, uy = (fx / mag, fy / mag) if mag > 0.0 else (0.0, 0.0)
-        x = min(max(mag / two_fth, 0.0), 1.0)
-        w = x * x * (3.0 - 2.0 * x)  # `transition_weight`
+        fz, mag, ux, uy, w = 0.0, 0.0, 0.0, 0.0, 0.0
+        if not is_local:
+            fz = forces[i, 2]
+            mag, ux, uy, w = _shear(forces[i, 0], forces[i, 1], two_fth)
         for g in range(grp_i.shape[1]):
             lo, hi = grp_i[_START, g], grp_i[_STOP, g]
             tuned, stretch = grp_i[_TUNED_G, g] != 0, grp_i[_SIGNED, g] != 0
             for j in range(lo, hi):
-                p = 1.0
-                if tuned and mag > 0.0:
-                    p = profile_value(ux, uy, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j], aff_f[_P1, j],
-                                      aff_f[_P2, j], aff_f[_P3, j], aff_f[_P4, j], aff_f[_P5, j], aff_f[_TIP, j])
-                if stretch:
-                    f[j] = mag * (p - opponent * (1.0 - p))  # `stretch_drive`
-                elif tuned:
-                    af = ((p - 1.0) * w) + 1.0 if smooth_reading else (p if mag > f_th else outside_value)
-                    f[j] = af * fz
-                else:
-                    f[j] = fz
+                if is_local:
+                    fz = local[i, j, 2]
+                    mag, ux, uy, w = _shear(local[i, j, 0], local[i, j, 1], two_fth)
+                f[j] = _drive(aff_f, j, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value, f_th,
+                              opponent)
             if i == 0 and not started and grp_i[_PLAIN, g] == 0:
                 offset[lo:hi] = f[lo:hi]  # `initial_filter_state`: at rest on the first sample
             for j in range(lo, hi):
@@ -219,23 +273,31 @@ class FusedPlan:
                            st.tau_s is not None, tuned[a], a, b]
         return grp_f, grp_i, sos_all
 
+    def local_drive(self, local) -> np.ndarray:
+        """Drive in newtons (F_A, or SA-II's stretch), shape (n_samples, n_afferents), from each afferent's
+        own force ``local`` (n_samples, n_afferents, 3): the offline multi-site path's first stage."""
+        return _local_drive(local, self.aff_f, self.aff_i, self.grp_i, self.smooth_reading, self.outside_value,
+                            self.f_th, self.opponent)
+
     def new_state(self) -> np.ndarray:
         """Filter, offset, difference, adaptation and smoothing state at rest, shape (n_rows, n_afferents)."""
         return np.zeros((self.rows + 5, self.n_afferents))
 
     def _drive(self, forces, normals, state, started):
-        noisy = normals is not None
-        drive = _front(forces, normals if noisy else _NO_NORMALS, noisy, state, started, self.aff_f, self.aff_i,
-                       self.grp_f, self.grp_i, self.sos, self.fs, self.smooth_reading, self.outside_value, self.f_th,
+        noisy, is_local = normals is not None, forces.ndim == 3
+        drive = _front(_NO_FORCES if is_local else forces, forces if is_local else _NO_LOCAL, is_local,
+                       normals if noisy else _NO_NORMALS, noisy, state, started, self.aff_f, self.aff_i, self.grp_f,
+                       self.grp_i, self.sos, self.fs, self.smooth_reading, self.outside_value, self.f_th,
                        self.opponent)
         for cols, stage in self.transducers:
             transduce_inplace(drive[:, cols], stage)
         return drive
 
     def currents(self, forces, normals, state, started):
-        """Currents (mV/ms), shape (n_samples, n_afferents), of forces (n_samples, 3) in newtons.
+        """Currents (mV/ms), shape (n_samples, n_afferents), of forces in newtons.
 
-        ``normals`` (shape (n_afferents, n_samples)) or None; ``state`` is
+        ``forces`` is (n_samples, 3), felt by every afferent, or each
+        afferent's own (n_samples, n_afferents, 3) (`mix_forces`).  ``normals`` (shape (n_afferents, n_samples)) or None; ``state`` is
         updated in place; ``started`` is False on the first chunk.
         """
         current = self._drive(forces, normals, state, started)

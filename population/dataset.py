@@ -15,6 +15,10 @@ Schema (names are fixed):
   ``spike_trial`` and ``spike_condition`` (positions), sorted by condition,
   trial, time and afferent; the forces ``fx``, ``fy``, ``fz``
   ``(condition, time)`` in N, zero after a shorter scene's end;
+* multi-site scenes only: dim ``site`` with coords ``site`` (id),
+  ``site_x_mm``, ``site_y_mm``, ``site_radius_mm`` (footprint) and
+  ``site_region``; with the forces recorded, ``site_fx``, ``site_fy``,
+  ``site_fz`` ``(condition, time, site)`` in N (``fx`` etc. are their sums);
 * attrs: engine, dt, method, seed, no-shear reading, package version and
   every model constant.  Every variable carries ``attrs["units"]``.
 """
@@ -154,8 +158,27 @@ def build_dataset(population, scenes, plan, spikes, config) -> xr.Dataset:
             for c, s in enumerate(scenes):
                 arr[c, : s.n_samples] = getattr(s, name)
             data[name] = xr.Variable(("condition", "time"), arr, {"units": "N"})
+    if scenes[0].sites is not None:
+        _add_sites(scenes, coords, data, "forces" in plan.record)
     attrs = dict(model_attrs(population, config), fs=float(scenes[0].fs), trials=n_t)
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _add_sites(scenes, coords, data, forces: bool) -> None:
+    """The ``site`` dimension of multi-site runs (all scenes share their sites), and per-site forces."""
+    sites = scenes[0].sites
+    coords["site"] = xr.Variable("site", np.asarray(sites.site_id, dtype=object), {"units": "1"})
+    for name, unit in (("x_mm", "mm"), ("y_mm", "mm"), ("radius_mm", "mm"), ("region", "1")):
+        values = getattr(sites, name)
+        coords[f"site_{name}"] = xr.Variable("site", values.astype(object) if unit == "1" else values,
+                                             {"units": unit})
+    if forces:
+        n_time = coords["time"].size
+        for axis, name in enumerate(("site_fx", "site_fy", "site_fz")):
+            arr = np.zeros((len(scenes), n_time, len(sites)))
+            for c, s in enumerate(scenes):
+                arr[c, : s.n_samples] = s.site_forces[:, :, axis]
+            data[name] = xr.Variable(("condition", "time", "site"), arr, {"units": "N"})
 
 
 def save_dataset(ds: xr.Dataset, path) -> Path:

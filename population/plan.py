@@ -31,7 +31,7 @@ from models._validation import check_choice
 from models.attenuation import F_TH, UNTUNED
 from models.currents import AFFERENT_TYPES
 
-from .spatial import receptive_field_weight
+from .spatial import receptive_field_weight, site_coverage
 
 __all__ = ["RECORD_CHOICES", "ConditionPlan", "Plan", "af_threshold", "make_plan"]
 
@@ -152,13 +152,16 @@ def _af_note(cond: ConditionPlan) -> str:
     return f"skipped (no shear that changes AF; AF = {cond.af_constant:g})"
 
 
-def _unit_keys(pop, sel, tuned, scale):
-    """Rows that identify afferents whose currents are bit-identical."""
+def _unit_keys(pop, sel, tuned, scale, local):
+    """Rows that identify afferents whose currents are bit-identical (``local``: also their position)."""
     type_code = np.array([AFFERENT_TYPES.index(t) for t in pop.afferent_type[sel]], dtype=float)
     nap_code = np.where(tuned, np.unique(pop.nap, return_inverse=True)[1][sel], -1).astype(float)
     theta = np.where(tuned, pop.theta_t[sel], 0.0)
     k = np.where(tuned, pop.k[sel], 0.0)
-    return np.column_stack([type_code, nap_code, theta, k, scale])
+    columns = [type_code, nap_code, theta, k, scale]
+    if local:  # each afferent feels its own force, a function of its type and position
+        columns += [pop.x_mm[sel], pop.y_mm[sel]]
+    return np.column_stack(columns)
 
 
 def af_threshold(no_shear: str) -> float:
@@ -177,11 +180,14 @@ def _quiet(pop, sel, scene, scale, af_stage, af_constant):
 
 
 def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
-    n = sel.size
-    af_stage = scene.max_shear() > af_threshold(no_shear) or not enabled
+    n, local = sel.size, scene.sites is not None
+    # A multi-site scene's local shear is a weighted sum of the sites' and can cross F_TH where none does.
+    af_stage = scene.max_shear() > (0.0 if local else af_threshold(no_shear)) or not enabled
     af_constant = 0.0 if no_shear == "block" else 1.0
     weights = None
-    if scene.contact is not None or not enabled:
+    if local:
+        weights = site_coverage(pop, scene.sites)[sel]
+    elif scene.contact is not None or not enabled:
         weights = (np.ones(n) if scene.contact is None else
                    receptive_field_weight(pop.x_mm[sel], pop.y_mm[sel], pop.afferent_type[sel], scene.contact))
     scale = pop.gain[sel] * (1.0 if weights is None else weights)
@@ -196,7 +202,7 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
     if deterministic.size:
         stretch = pop.afferent_type[sel[deterministic]] == "SAII"
         tuned = (pop.nap[sel[deterministic]] != UNTUNED) & np.where(stretch, scene.max_shear() > 0.0, af_stage)
-        keys = _unit_keys(pop, sel[deterministic], tuned, scale[deterministic])
+        keys = _unit_keys(pop, sel[deterministic], tuned, scale[deterministic], local)
         _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
         order = np.argsort(first)  # units in population order, for readable plans
         rank = np.empty_like(order)

@@ -243,7 +243,9 @@ class Scene:
         return np.arange(self.n_samples) / self.fs
 
     def max_shear(self) -> float:
-        """Largest shear magnitude in newtons."""
+        """Largest shear magnitude in newtons (at any one site of a multi-site scene)."""
+        if self.sites is not None:
+            return float(np.max(np.hypot(self.site_forces[:, :, 0], self.site_forces[:, :, 1])))
         return float(np.max(np.hypot(self.fx, self.fy)))
 
 

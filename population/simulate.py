@@ -22,11 +22,13 @@ from models.attenuation import (NO_SHEAR_READINGS, UNTUNED, attenuated_force, at
                                 stretch_drive)
 from models.currents import check_fs, current_core
 from models.engines import ENGINES, METHODS, integrate, prepare, substeps_for
+from models.fused import mix_forces
 
 from .noise import draw_noise, noise_current, noise_streams, root_seed
 from .plan import RECORD_CHOICES, make_plan
 from .sampling import Population
 from .scenes import Scene
+from .spatial import site_drive
 
 __all__ = ["SimConfig", "ChunkJob", "run_chunk", "simulate", "plan_run", "population_currents"]
 
@@ -112,9 +114,16 @@ def _runs(*columns) -> list:
     return [(values[0][a], slice(int(a), int(b))) for a, b in zip(starts, ends)]
 
 
-def _attenuated(job: ChunkJob, sl: slice, no_shear: str) -> np.ndarray:
-    """Each afferent's drive over samples ``sl`` in newtons: F_A, or SA-II's stretch."""
+def _attenuated(job: ChunkJob, sl: slice, no_shear: str, sites=None) -> np.ndarray:
+    """Each afferent's drive over samples ``sl`` in newtons: F_A, or SA-II's stretch.
+
+    ``sites`` (`spatial.site_drive` of the block) for a multi-site scene:
+    each afferent then feels its own local force.
+    """
     pop, scene = job.population, job.scene
+    if sites is not None:
+        plan, indptr, indices, coeff = sites
+        return plan.local_drive(mix_forces(scene.site_forces[sl], indptr, indices, coeff))
     fz = scene.fz[sl]
     f_a = np.empty((fz.size, len(pop)))
     for profile, cols in _runs(pop.nap, pop.afferent_type):
@@ -159,10 +168,11 @@ def _run_trial(job: ChunkJob, trial: int, config: SimConfig, progress=None):
     streams = noise_streams(config.seed, job.condition, trial, pop.afferent_id) if job.noisy else None
     substeps = substeps_for(scene.fs, config.dt)
     filters, neuron, afferents, steps = {}, None, [], []
+    sites = None if scene.sites is None else site_drive(pop, scene.sites, scene.fs, config.no_shear)
     for start in range(0, scene.n_samples, config.time_chunk):
         sl = slice(start, min(scene.n_samples, start + config.time_chunk))
         normals = None if streams is None else draw_noise(streams, sl.stop - sl.start)
-        current = _currents(job, _attenuated(job, sl, config.no_shear), filters, scale, normals)
+        current = _currents(job, _attenuated(job, sl, config.no_shear, sites), filters, scale, normals)
         res = integrate(current, fs=scene.fs, dt=config.dt, afferent_type=pop.afferent_type,
                         engine=config.engine, method=config.method, state=neuron)
         neuron = res.state
@@ -180,16 +190,19 @@ def population_currents(population, scene, *, no_shear: str = "smooth") -> np.nd
     for inspection and for the reference solver; noise is not added.
     """
     check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
+    from .spatial import receptive_field_weight, site_coverage
+
     weights = None
     if scene.contact is not None:
-        from .spatial import receptive_field_weight
-
         weights = receptive_field_weight(population.x_mm, population.y_mm, population.afferent_type, scene.contact)
+    elif scene.sites is not None:
+        weights = site_coverage(population, scene.sites)
     scale = population.gain if weights is None else population.gain * weights
     order = _grouped(population, np.arange(len(population)), np.arange(len(population)))
     job = ChunkJob(scene, population.select(order), 0, (0,), False, True, 0.0 if no_shear == "block" else 1.0,
                    None if weights is None else weights[order])
-    current = _currents(job, _attenuated(job, slice(None), no_shear), {}, scale[order])
+    sites = None if scene.sites is None else site_drive(job.population, scene.sites, scene.fs, no_shear)
+    current = _currents(job, _attenuated(job, slice(None), no_shear, sites), {}, scale[order])
     out = np.empty_like(current)
     out[:, order] = current
     return out
@@ -206,6 +219,23 @@ def run_chunk(job: ChunkJob, config: SimConfig, progress=None):
     return np.concatenate(trials), np.concatenate(afferents), np.concatenate(steps)
 
 
+def _check_sites(scenes) -> None:
+    """Multi-site scenes of one run share their sites (the dataset's ``site`` dimension)."""
+    multi = [s for s in scenes if s.sites is not None]
+    if not multi:
+        return
+    if len(multi) != len(scenes):
+        raise ValueError(f"scenes mix one-site and multi-site conditions ({[s.name for s in scenes]}); "
+                         "simulate them in separate runs")
+    first = multi[0].sites
+    for s in multi[1:]:
+        same = len(s.sites) == len(first) and all(
+            np.array_equal(getattr(s.sites, f), getattr(first, f)) for f in ("x_mm", "y_mm", "radius_mm", "site_id"))
+        if not same:
+            raise ValueError(f"scene {s.name!r} has other sites than scene {multi[0].name!r}; the scenes of one "
+                             "run must share their sites")
+
+
 def _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_size, time_chunk):
     if not isinstance(population, Population):
         raise TypeError(f"population must be a Population (see sample_population), got {type(population).__name__}")
@@ -217,6 +247,7 @@ def _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_si
     names = [s.name for s in scenes]
     if len(set(names)) != len(names):
         raise ValueError(f"scene names must be unique (they label conditions), got {names}")
+    _check_sites(scenes)
     check_choice(engine, "engine", ENGINES)
     check_choice(method, "method", METHODS)
     check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)

@@ -1,11 +1,26 @@
-"""Receptive fields: how strongly a contact drives each afferent, by distance.
+"""Receptive fields and local drive: how strongly each force site drives each afferent.
 
-An afferent inside the contact disc gets weight 1.  Outside, the weight
-falls as a Gaussian of the distance beyond the disc's edge, with a width
-per type, and is exactly 0 beyond ``RF_SUPPORT`` widths (so such afferents
-provably stay at rest and are skipped).  Widths follow receptive-field sizes
-in human glabrous skin (Johansson & Vallbo 1980): SA-I and FA-I fields are a
-few mm across, FA-II (Pacinian) fields cover much of a finger.
+**Weights.**  An afferent inside a contact (or site) footprint gets weight
+1.  Outside, the weight falls as a Gaussian of the distance beyond the
+footprint's edge, with a width per type, and is exactly 0 beyond
+``RF_SUPPORT`` widths (so such afferents provably stay at rest and are
+skipped).  The widths follow PHYSIOLOGY.md row 17 (Johansson & Vallbo
+1980): a point probe drives an afferent at half weight or more over an area
+equal to the type's median receptive field, 11.0 mm^2 (SA-I), 12.6 mm^2
+(FA-I), about 5x SA-I's for SA-II and 10x for FA-II.
+
+**Local force of a multi-site scene** (`local_mixing`).  The DDMM's force is
+the force on a fingertip-sized contact, so a site's force counts as the
+traction over its footprint (area a_s) times the reference area
+``REFERENCE_AREA_MM2`` (A_ref).  Afferent i, with weights w_is summing to
+S_i over the sites that reach it, receives
+
+    F_i = sum_s (w_is / S_i) (A_ref / a_s) F_s      (three axes)
+
+the weighted mean of the sites' tractions times A_ref, and its drive is
+scaled by the coverage ``min(S_i, 1)`` (the one-site scene's weight).  Its
+own local shear direction then drives its AF.  A site whose footprint is
+A_ref, alone over an afferent, gives F_i = F_s exactly: the one-site scene.
 """
 
 from __future__ import annotations
@@ -14,10 +29,20 @@ import numpy as np
 
 from models.currents import AFFERENT_TYPES
 
-__all__ = ["RF_SIGMA_MM", "RF_SUPPORT", "receptive_field_weight"]
+from .scenes import Contact
 
-#: Receptive-field fall-off width (Gaussian sigma) per type, in mm.
-RF_SIGMA_MM = {"SAI": 1.0, "RAI": 1.5, "RAII": 8.0, "SAII": 2.2}  # SA-II: ~5x the SA-I field area (row 17)
+__all__ = ["RF_AREA_MM2", "RF_SIGMA_MM", "RF_SUPPORT", "REFERENCE_AREA_MM2", "receptive_field_weight",
+           "site_weights", "local_mixing", "site_coverage", "site_drive"]
+
+#: Median receptive-field area per type in mm^2 (PHYSIOLOGY.md row 17: SA-I, FA-I read (V); SA-II about
+#: 5x and FA-II about 10x larger, read in a secondary source (V2)).
+RF_AREA_MM2 = {"SAI": 11.0, "RAI": 12.6, "SAII": 5 * 11.0, "RAII": 10 * 12.6}
+#: Gaussian fall-off width per type (mm): a point probe gets weight >= 1/2 within sigma * sqrt(2 ln 2),
+#: a disc whose area is the type's median field.
+RF_SIGMA_MM = {kind: float(np.sqrt(area / np.pi) / np.sqrt(2.0 * np.log(2.0))) for kind, area in RF_AREA_MM2.items()}
+#: The contact area the model's forces refer to, mm^2: a fingertip pad under a flat surface at 2-4 N,
+#: a disc of 6 mm radius (recalled, not read in a stored source: R).
+REFERENCE_AREA_MM2 = float(np.pi * 6.0 ** 2)
 #: Weights are exactly 0 beyond this many widths outside the contact.
 RF_SUPPORT = 3.0
 
@@ -37,7 +62,8 @@ def receptive_field_weight(x_mm, y_mm, afferent_type, contact) -> np.ndarray:
     Examples
     --------
     >>> from population.scenes import Contact
-    >>> w = receptive_field_weight([0.0, 2.0, 9.0], [0.0, 0.0, 0.0], ["SAI"] * 3, Contact(0.0, 0.0, 1.0))
+    >>> w = receptive_field_weight([0.0, 1.0 + RF_SIGMA_MM["SAI"], 9.0], [0.0, 0.0, 0.0], ["SAI"] * 3,
+    ...                            Contact(0.0, 0.0, 1.0))
     >>> w.round(3).tolist()
     [1.0, 0.607, 0.0]
     """
@@ -51,3 +77,90 @@ def receptive_field_weight(x_mm, y_mm, afferent_type, contact) -> np.ndarray:
     weight = np.exp(-0.5 * (excess / sigma) ** 2)
     weight[excess > RF_SUPPORT * sigma] = 0.0
     return weight
+
+
+def site_weights(x_mm, y_mm, afferent_type, sites) -> np.ndarray:
+    """Receptive-field weight of every afferent for every site, shape (n_afferents, n_sites).
+
+    Each site's footprint is a disc (``sites.radius_mm``); see
+    `receptive_field_weight`.
+
+    Examples
+    --------
+    >>> from population.scenes import Sites
+    >>> w = site_weights([0.0, 9.0], [0.0, 0.0], ["SAI", "SAI"], Sites([0.0, 9.0], [0.0, 0.0], 1.0))
+    >>> w.round(3).tolist()
+    [[1.0, 0.0], [0.0, 1.0]]
+    """
+    out = np.empty((np.size(x_mm), len(sites)))
+    for s in range(len(sites)):
+        disc = Contact(float(sites.x_mm[s]), float(sites.y_mm[s]), float(sites.radius_mm[s]))
+        out[:, s] = receptive_field_weight(x_mm, y_mm, afferent_type, disc)
+    return out
+
+
+def local_mixing(x_mm, y_mm, afferent_type, sites):
+    """Sparse coefficients of each afferent's local force and its coverage (module docstring).
+
+    Returns
+    -------
+    indptr : ndarray of int64, shape (n_afferents + 1,)
+    indices : ndarray of int64
+        Sites reaching afferent i: ``indices[indptr[i]:indptr[i + 1]]``.
+    coeff : ndarray of float
+        Their coefficients ``(w_is / S_i) (A_ref / a_s)`` (dimensionless).
+    coverage : ndarray of float, shape (n_afferents,)
+        ``min(S_i, 1)``, the drive's scale; 0 for afferents no site reaches.
+
+    Examples
+    --------
+    >>> from population.scenes import Sites
+    >>> r = float(np.sqrt(REFERENCE_AREA_MM2 / np.pi))
+    >>> indptr, indices, coeff, cover = local_mixing([0.0, 40.0], [0.0, 0.0], ["SAI"] * 2, Sites([0.0], [0.0], r))
+    >>> indptr.tolist(), coeff.tolist(), cover.tolist()
+    ([0, 1, 1], [1.0], [1.0, 0.0])
+    """
+    w = site_weights(x_mm, y_mm, afferent_type, sites)
+    total = w.sum(axis=1)
+    rows, cols = np.nonzero(w)
+    factor = REFERENCE_AREA_MM2 / sites.area_mm2
+    coeff = (w[rows, cols] / total[rows]) * factor[cols]
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=w.shape[0]))]).astype(np.int64)
+    return indptr, cols.astype(np.int64), coeff, np.minimum(total, 1.0)
+
+
+def site_coverage(population, sites) -> np.ndarray:
+    """Each afferent's coverage ``min(S_i, 1)`` by a multi-site scene's sites (its drive scale).
+
+    Raises
+    ------
+    ValueError
+        If a site reaches no afferent of the population (it lies outside
+        every region the population covers), naming the site.
+    """
+    w = site_weights(population.x_mm, population.y_mm, population.afferent_type, sites)
+    dead = np.flatnonzero(~np.any(w > 0.0, axis=0))
+    if dead.size:
+        s = dead[0]
+        raise ValueError(f"site {sites.site_id[s]!r} at ({sites.x_mm[s]:g}, {sites.y_mm[s]:g}) mm reaches no "
+                         f"afferent of population {population.name!r}: it lies outside every region the "
+                         "population covers")
+    return np.minimum(w.sum(axis=1), 1.0)
+
+
+def site_drive(population, sites, fs: float, no_shear: str):
+    """What turns site forces into each afferent's drive: (`FusedPlan`, indptr, indices, coeff).
+
+    ``population`` must be grouped by type (as `simulate`'s blocks are).
+    ``plan.local_drive(mix_forces(forces, indptr, indices, coeff))`` gives
+    the drive in newtons, shape (n_samples, n_afferents).
+    """
+    from models.attenuation import F_TH
+    from models.fused import FusedPlan
+
+    pop = population
+    indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, sites)
+    ones, zeros = np.ones(len(pop)), np.zeros(len(pop))
+    plan = FusedPlan(pop.afferent_type, pop.nap, pop.theta_t, pop.k, ones, zeros, zeros, pop.current, fs, no_shear,
+                     F_TH)
+    return plan, indptr, indices, coeff

@@ -30,13 +30,14 @@ from models.currents import check_fs
 from models.direct import _BLOCK, _METHOD_CODES
 from models.engines import (ENGINES, METHODS, NeuronState, check_integration, check_stability, integrate, prepare,
                             substeps_for)
-from models.fused import FusedPlan
+from models.fused import FusedPlan, mix_forces
 from models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
 
 from .noise import draw_noise, noise_streams, root_seed
 from .sampling import Population
-from .scenes import Contact
+from .scenes import Contact, Sites
 from .simulate import _grouped
+from .spatial import local_mixing, receptive_field_weight, site_coverage
 
 __all__ = ["StreamSpikes", "Encoder"]
 
@@ -80,6 +81,10 @@ class Encoder:
         Reading of eq. 17 (default "smooth", as `simulate`).
     contact : Contact, optional
         Fixed contact geometry, for receptive-field weighting.
+    sites : Sites, optional
+        The force sites of a sensor array or multi-digit hand: chunks are
+        then (n, n_sites, 3), and each afferent feels its own local force
+        (`population.spatial`), as `simulate` does for `Scene.from_sites`.
     noise_block : int
         Noise samples drawn ahead per afferent.
 
@@ -93,7 +98,8 @@ class Encoder:
     """
 
     def __init__(self, population, fs: float, *, dt: float = 1e-4, engine: str = "direct", method: str = "euler",
-                 seed=None, no_shear: str = "smooth", contact: Contact | None = None, noise_block: int = 1000):
+                 seed=None, no_shear: str = "smooth", contact: Contact | None = None, sites: Sites | None = None,
+                 noise_block: int = 1000):
         if not isinstance(population, Population):
             raise TypeError(f"population must be a Population, got {type(population).__name__}")
         self.fs = check_positive(fs, "fs", "Hz")
@@ -103,7 +109,11 @@ class Encoder:
         self.no_shear = check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
         if contact is not None and not isinstance(contact, Contact):
             raise TypeError(f"contact must be a Contact or None, got {type(contact).__name__}")
+        if sites is not None and (not isinstance(sites, Sites) or contact is not None):
+            raise TypeError("sites must be a Sites (and then no contact is given), got "
+                            f"{type(sites).__name__} with contact={contact!r}")
         self.seed, self.contact, self.noise_block = root_seed(seed), contact, int(noise_block)
+        self.sites = sites
         check_fs(self.fs, population.current, tuple(np.unique(population.afferent_type)))
         idx = np.arange(len(population))
         self._order = _grouped(population, idx, idx)  # contiguous (type, NAP) groups, as offline
@@ -115,11 +125,12 @@ class Encoder:
     def _precompute(self) -> None:
         """The fused plan's tables (the same values the offline path uses) and the integrator's constants."""
         pop = self._pop
-        scale = pop.gain
+        scale, self._mixing = pop.gain, None
         if self.contact is not None:
-            from .spatial import receptive_field_weight
-
             scale = pop.gain * receptive_field_weight(pop.x_mm, pop.y_mm, pop.afferent_type, self.contact)
+        elif self.sites is not None:
+            scale = pop.gain * site_coverage(pop, self.sites)
+            self._mixing = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, self.sites)[:3]
         self._plan = FusedPlan(pop.afferent_type, pop.nap, pop.theta_t, pop.k, scale, pop.noise_cv, pop.noise_sigma,
                                pop.current, self.fs, self.no_shear, F_TH)
         p = neuron_arrays(pop.afferent_type)
@@ -187,9 +198,13 @@ class Encoder:
 
     def _validate(self, forces, times):
         forces = as_finite_array(forces, "forces")
-        if forces.ndim != 2 or forces.shape[1] != 3:
+        if self.sites is not None:
+            if forces.ndim != 3 or forces.shape[1:] != (len(self.sites), 3):
+                raise ValueError(f"forces must have shape (n, n_sites, 3) = (n, {len(self.sites)}, 3) for the "
+                                 f"encoder's sites, got {forces.shape}")
+        elif forces.ndim != 2 or forces.shape[1] != 3:
             raise ValueError(f"forces must have shape (n, 3) for (fx, fy, fz), got {forces.shape}")
-        if np.any(forces[:, 2] < 0):
+        if np.any(forces[..., 2] < 0):
             raise ValueError("forces: the normal force fz must be >= 0 N")
         if times is not None:
             times = as_finite_array(times, "times", ndim=1)
@@ -222,6 +237,8 @@ class Encoder:
         if n == 0:
             return StreamSpikes(np.empty(0, np.int64), np.empty(0))
         state = self._state.copy()  # committed only if the whole chunk succeeds
+        if self._mixing is not None:
+            forces = mix_forces(forces, *self._mixing)  # each afferent's own force, (n, n_afferents, 3)
         normals = None if self._streams is None else self._peek_noise(n).T
         afferent, step, v, u = self._run(forces, normals, state)
         step0 = self._samples * self.substeps
