@@ -195,10 +195,7 @@ class Scene:
         if forces.shape != (n_samples, len(self.sites), 3):
             raise ValueError(f"site_forces must have shape (n_samples, n_sites, 3) = ({n_samples}, "
                              f"{len(self.sites)}, 3), got {forces.shape}")
-        if np.any(forces[:, :, 2] < 0):
-            k, j = np.argwhere(forces[:, :, 2] < 0)[0]
-            raise ValueError(f"site_forces: fz must be >= 0 N; got {forces[k, j, 2]!r} at site "
-                             f"{self.sites.site_id[j]!r}, t = {k / self.fs} s")
+        _check_site_fz(forces, self.sites, self.fs)
         forces.setflags(write=False)
         object.__setattr__(self, "site_forces", forces)
 
@@ -217,8 +214,9 @@ class Scene:
         (2, 2.0)
         """
         forces = as_finite_array(forces, "forces", ndim=3)
-        if forces.ndim != 3 or forces.shape[2] != 3:
-            raise ValueError(f"forces must have shape (n_samples, n_sites, 3), got {forces.shape}")
+        if forces.shape[2] != 3 or not isinstance(sites, Sites) or forces.shape[1] != len(sites):
+            raise ValueError(f"forces must have shape (n_samples, n_sites, 3) for its Sites, got {forces.shape}")
+        _check_site_fz(forces, sites, fs)
         total = forces.sum(axis=1)
         return cls(total[:, 0], total[:, 1], total[:, 2], fs, name, stages, None, theta_r, sites, forces)
 
@@ -247,6 +245,13 @@ class Scene:
         if self.sites is not None:
             return float(np.max(np.hypot(self.site_forces[:, :, 0], self.site_forces[:, :, 1])))
         return float(np.max(np.hypot(self.fx, self.fy)))
+
+
+def _check_site_fz(forces, sites, fs) -> None:
+    if np.any(forces[:, :, 2] < 0):
+        k, j = np.argwhere(forces[:, :, 2] < 0)[0]
+        raise ValueError(f"site_forces: fz must be >= 0 N; got {float(forces[k, j, 2])!r} at site "
+                         f"{sites.site_id[j]!r}, t = {k / fs} s")
 
 
 def _samples(duration: float, fs: float) -> np.ndarray:
