@@ -86,7 +86,7 @@ def read_long_forces(path, known: dict):
         for a, col in enumerate(("fx", "fy", "fz")):
             force[r, a] = _cell_float(where, col, line, row[index[col]])
         if force[r, 2] < 0:
-            raise ValueError(f"{where}: column 'fz', line {line}: negative normal force {force[r, 2]!r} N")
+            raise ValueError(f"{where}: column 'fz', line {line}: negative normal force {float(force[r, 2])!r} N")
     return where, t, site, force, lines
 
 
@@ -104,8 +104,8 @@ def uniform_grid(where: str, times: np.ndarray, fs: float | None, t: np.ndarray,
     if np.any(off > TIME_TOL):
         i = int(np.flatnonzero(off > TIME_TOL)[0])
         line = int(lines[np.flatnonzero(t == times[i])].min())
-        raise ValueError(f"{where}: column 'time', line {line}: {times[i]!r} s is off the uniform grid of "
-                         f"step {step!r} s (sites with different time stamps, or a gap)")
+        raise ValueError(f"{where}: column 'time', line {line}: {float(times[i])!r} s is off the uniform grid of "
+                         f"step {float(step)!r} s (sites with different time stamps, or a gap)")
     if fs is not None and abs(step * fs - 1.0) > TIME_TOL:
-        raise ValueError(f"{where}: column 'time' has a step of {step!r} s, which does not match fs = {fs!r} Hz")
+        raise ValueError(f"{where}: column 'time' has a step of {float(step)!r} s, which does not match fs = {fs!r} Hz")
     return 1.0 / step if fs is None else fs

@@ -130,7 +130,7 @@ def _numeric(where: str, key: str, value, shape) -> np.ndarray:
     bad = ~np.isfinite(arr)
     if bad.any():
         index = tuple(int(i) for i in np.argwhere(bad)[0])
-        raise ValueError(f"{where}: field {key!r} has a non-finite value {arr[index]!r} at index {list(index)}")
+        raise ValueError(f"{where}: field {key!r} has a non-finite value {float(arr[index])!r} at index {list(index)}")
     return arr
 
 
@@ -161,7 +161,7 @@ def _scene_from_fields(where: str, fields: dict, name: str) -> Scene:
     negative = forces[:, :, 2] < 0
     if negative.any():
         k, j = (int(i) for i in np.argwhere(negative)[0])
-        raise ValueError(f"{where}: field 'forces' has a negative normal force {forces[k, j, 2]!r} N at index "
+        raise ValueError(f"{where}: field 'forces' has a negative normal force {float(forces[k, j, 2])!r} N at index "
                          f"[{k}, {j}, 2] (F_Z must be >= 0)")
     x = _numeric(where, "x_mm", fields["x_mm"], (n_sites,))
     y = _numeric(where, "y_mm", fields["y_mm"], (n_sites,))
@@ -180,7 +180,7 @@ def _sites(where: str, fields: dict, x: np.ndarray, y: np.ndarray) -> Sites:
         radius = _numeric(where, "radius_mm", raw, () if raw.ndim == 0 else (n,))
         if np.any(radius <= 0):
             i = int(np.flatnonzero(np.atleast_1d(radius) <= 0)[0])
-            raise ValueError(f"{where}: field 'radius_mm' must be > 0 mm, got {np.atleast_1d(radius)[i]!r} "
+            raise ValueError(f"{where}: field 'radius_mm' must be > 0 mm, got {float(np.atleast_1d(radius)[i])!r} "
                              f"at index [{i}]")
     region = None if fields.get("region") is None else _strings(where, "region", fields["region"], n)
     ids = None if fields.get("site") is None else _strings(where, "site", fields["site"], n)
@@ -237,7 +237,7 @@ def _check_time_coordinate(where: str, time, fs: float) -> None:
     off = np.abs(t - t[0] - np.arange(t.size) / fs) * fs
     if np.any(off > TIME_TOL):
         i = int(np.flatnonzero(off > TIME_TOL)[0])
-        raise ValueError(f"{where}: field 'time' is not uniform at fs = {fs!r} Hz: {t[i]!r} s at index [{i}]")
+        raise ValueError(f"{where}: field 'time' is not uniform at fs = {fs!r} Hz: {float(t[i])!r} s at index [{i}]")
 
 
 def _read_hdf5(path, where: str) -> dict:
@@ -455,13 +455,13 @@ def from_long_csv(forces_csv, sites_csv, *, fs: float | None = None, name: str |
         k, j = slot[r], site[r]
         if filled[k, j] >= 0:
             raise ValueError(f"{where}: line {lines[r]}: duplicate row for site {table['site'][j]!r} at time "
-                             f"{t[r]!r} s (first on line {lines[filled[k, j]]})")
+                             f"{float(t[r])!r} s (first on line {lines[filled[k, j]]})")
         filled[k, j] = r
     if np.any(filled < 0):
         k, j = (int(i) for i in np.argwhere(filled < 0)[0])
         s = table["site"][j]
         raise ValueError(f"{where}: column 'site': site {s!r} (sites file line {site_lines[s]}) has no sample "
-                         f"at time {times[k]!r} s")
+                         f"at time {float(times[k])!r} s")
     fields = {"fs": fs, "forces": force[filled], "x_mm": table["x_mm"], "y_mm": table["y_mm"],
               "radius_mm": table["radius_mm"], "region": table["region"], "site": table["site"]}
     # the forces are checked row by row above; what is left to fail is the sites' footprint
