@@ -20,8 +20,8 @@ def _csv_rows(path, what: str, required: tuple, optional: tuple = ()):
     where = f"{what} file {str(path)!r}"
     try:
         with open(path, newline="") as fh:
-            rows = [(i, row) for i, row in enumerate(csv.reader(fh), start=1)
-                    if row and any(cell.strip() for cell in row)]
+            reader = csv.reader(fh)
+            rows = [(reader.line_num, row) for row in reader if row and any(cell.strip() for cell in row)]
     except OSError as exc:
         raise ValueError(f"{where} cannot be read: {exc.strerror}") from None
     if not rows:

@@ -106,9 +106,11 @@ def default_radius(x_mm, y_mm) -> float:
     x, y = np.asarray(x_mm, dtype=float), np.asarray(y_mm, dtype=float)
     if x.size < 2:
         raise ValueError(f"radius_mm is required with {x.size} site(s): the taxel pitch needs two or more sites")
-    dist = np.hypot(x[:, None] - x[None, :], y[:, None] - y[None, :])
-    np.fill_diagonal(dist, np.inf)
-    pitch = float(np.median(dist.min(axis=1)))
+    from scipy.spatial import cKDTree  # O(n log n): arrays can have thousands of taxels
+
+    points = np.column_stack([x, y])
+    nearest = cKDTree(points).query(points, k=2)[0][:, 1]
+    pitch = float(np.median(nearest))
     if not pitch > 0:
         raise ValueError("radius_mm is required: the median nearest-neighbour distance between sites is 0 mm "
                          "(coincident sites)")
@@ -142,6 +144,9 @@ def _strings(where: str, key: str, value, n: int) -> np.ndarray:
 
 
 def _check_fs(where: str, value) -> float:
+    value = np.asarray(value)
+    if value.shape == (1,):  # netCDF and HDF5 tools often store a scalar attribute as a 1-element array
+        value = value[0]
     fs = _numeric(where, "fs", value, ())
     if not fs > 0:
         raise ValueError(f"{where}: field 'fs' must be > 0 Hz, got {float(fs)!r}")

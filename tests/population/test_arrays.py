@@ -86,6 +86,10 @@ def test_foreign_netcdf_and_hdf5_layouts(tmp_path):
     s = from_array(tmp_path / "b.h5")
     assert s.fs == 50.0 and s.sites.radius_mm[0] == pytest.approx(taxel_radius(2.5))
     assert list(s.sites.region) == ["", ""] and list(s.sites.site_id) == ["0", "1"]
+    with h5py.File(tmp_path / "b.h5", "a") as fh:
+        del fh["fs"]
+        fh.attrs["fs"] = np.array([75.0])  # a one-element attribute, as netCDF-C tools write scalars
+    assert from_array(tmp_path / "b.h5").fs == 75.0
 
 
 def test_default_radius_is_equal_area_of_median_pitch(tmp_path):
