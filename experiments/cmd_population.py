@@ -8,9 +8,10 @@ from pathlib import Path
 
 from models.engines import SpikeCapWarning
 
-from population import (Contact, birznieks, describe_dataset, from_csv, load_dataset, load_spec,
-                        plan_run, press_push_lift, psth, rotating_shear, sample_population,
+from population import (Contact, birznieks, describe_dataset, from_array, from_csv, from_long_csv, load_dataset,
+                        load_spec, plan_run, press_push_lift, psth, rotating_shear, sample_population,
                         save_dataset, simulate)
+from population.arrays import EXTENSIONS
 
 from .io import ensure_out_dir, save_figure
 
@@ -21,7 +22,12 @@ SCENES = ("birznieks", "press-push-lift", "rotating-shear")
 
 def _add_run_options(p, *, out_required: bool) -> None:
     p.add_argument("--population", default="fingertip", help="fingertip, hand or a spec .toml file")
-    p.add_argument("--scene", default="birznieks", help=f"{', '.join(SCENES)} or a force .csv file")
+    p.add_argument("--scene", default="birznieks",
+                   help=f"{', '.join(SCENES)}, a force .csv file, or a sensor-array file "
+                        f"({', '.join(EXTENSIONS)}; a long .csv with --sites)")
+    p.add_argument("--sites", default=None, metavar="SITES.csv",
+                   help="sites table (site,x_mm,y_mm[,region][,radius_mm]): --scene is then a long CSV "
+                        "of time,site,fx,fy,fz")
     p.add_argument("--theta-r", default=None, metavar="DEG[,DEG...]",
                    help="shear direction(s) in degrees, one condition each ('none': normal only); default 90")
     p.add_argument("--contact", default=None, metavar="X,Y,R", help="contact centre and radius in mm")
@@ -84,8 +90,26 @@ def _contact(text):
     return Contact(x, y, r)
 
 
+def _array_scene(args):
+    """The sensor-array scene of ``--scene FILE`` (and ``--sites``), or None for any other ``--scene``."""
+    suffix = Path(args.scene).suffix.lower()
+    is_array = suffix in EXTENSIONS or (suffix == ".csv" and args.sites is not None)
+    if args.sites is not None and suffix != ".csv":
+        raise ValueError(f"--sites goes with a long .csv --scene (time,site,fx,fy,fz), not {args.scene!r}")
+    if not is_array:
+        return None
+    if args.contact is not None:
+        raise ValueError("--contact does not apply to a sensor-array scene: each site has its own footprint")
+    if args.theta_r is not None:
+        raise ValueError("--theta-r does not apply to a sensor-array scene: the file gives the forces")
+    return from_array(args.scene) if suffix in EXTENSIONS else from_long_csv(args.scene, args.sites)
+
+
 def scenes_from_args(args) -> list:
-    """The scenes named by ``--scene``, ``--theta-r`` and ``--contact``."""
+    """The scenes named by ``--scene``, ``--sites``, ``--theta-r`` and ``--contact``."""
+    array = _array_scene(args)
+    if array is not None:
+        return [array]
     contact = _contact(args.contact)
     if args.scene == "birznieks":
         return [birznieks(d, contact=contact) for d in _directions(args.theta_r)]
@@ -99,7 +123,8 @@ def scenes_from_args(args) -> list:
         return [rotating_shear(start_deg=start[0] or 0.0, contact=contact)]
     if args.scene.endswith(".csv"):
         return [from_csv(args.scene, contact=contact)]
-    raise ValueError(f"--scene {args.scene!r} is unknown; allowed: {', '.join(SCENES)} or a .csv file")
+    raise ValueError(f"--scene {args.scene!r} is unknown; allowed: {', '.join(SCENES)}, a .csv file or a "
+                     f"sensor-array file ({', '.join(EXTENSIONS)})")
 
 
 def _types(text):

@@ -1,0 +1,100 @@
+"""ddmm simulate / plan --scene with sensor-array files (NPZ, netCDF, HDF5, long CSV + --sites)."""
+
+import numpy as np
+import pytest
+
+from experiments.cli import main
+from population import load_dataset
+from population.arrays import save_array
+from population.scenes import Scene, Sites
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def pad_scene(loaded_site=0, n_samples=200):
+    """Four taxels on a 2 mm grid; only ``loaded_site`` is pressed (1 N for 0.1 s)."""
+    forces = np.zeros((n_samples, 4, 3))
+    forces[n_samples // 4: 3 * n_samples // 4, loaded_site, 2] = 1.0
+    return Scene.from_sites(forces, Sites([0.0, 2.0, 0.0, 2.0], [0.0, 0.0, 2.0, 2.0], 1.1), fs=1000.0)
+
+
+@pytest.mark.parametrize("ext", (".npz", ".nc", ".h5", ".hdf5"))
+def test_plan_reads_each_array_format(capsys, tmp_path, ext):
+    path = save_array(tmp_path / f"pad{ext}", pad_scene())
+    code, text, err = run(capsys, "plan", "--scene", path, "--types", "SAI")
+    assert code == 0 and "condition 'pad': 0.2 s at 1000 Hz" in text, err
+
+
+def test_plan_reads_long_csv_with_sites(capsys, tmp_path):
+    (tmp_path / "f.csv").write_text("time,site,fx,fy,fz\n0,a,0,0,1\n0,b,0,0,1\n0.01,a,0,0,1\n0.01,b,0,0,1\n")
+    (tmp_path / "s.csv").write_text("site,x_mm,y_mm\na,0,0\nb,2,0\n")
+    code, text, err = run(capsys, "plan", "--scene", tmp_path / "f.csv", "--sites", tmp_path / "s.csv")
+    assert code == 0 and "condition 'f': 0.02 s at 100 Hz" in text, err
+
+
+def test_csv_without_sites_keeps_the_single_site_reader(capsys, tmp_path):
+    (tmp_path / "one.csv").write_text("time,fx,fy,fz\n0,0,0,1\n0.01,0,0,1\n")
+    code, text, err = run(capsys, "plan", "--scene", tmp_path / "one.csv")
+    assert code == 0 and "condition 'one'" in text, err
+
+
+def test_simulate_array_scene_writes_dataset(capsys, tmp_path):
+    """End to end through today's simulate (which drives the population with the sites' total force)."""
+    path = save_array(tmp_path / "pad.npz", pad_scene())
+    out = tmp_path / "run.nc"
+    code, text, err = run(capsys, "simulate", "--scene", path, "--engine", "direct", "--types", "SAI",
+                          "--quiet", "--out", out)
+    assert code == 0, err
+    assert list(load_dataset(out).condition.values) == ["pad"]
+
+
+@pytest.mark.skip(reason="needs multi-site simulate (the lead's parallel work): sites must change who is driven")
+def test_simulate_honours_array_sites(capsys, tmp_path):
+    counts = []
+    for site in (0, 3):
+        path = save_array(tmp_path / f"pad{site}.npz", pad_scene(loaded_site=site))
+        out = tmp_path / f"run{site}.nc"
+        code, _, err = run(capsys, "simulate", "--scene", path, "--engine", "direct", "--types", "SAI",
+                           "--quiet", "--out", out)
+        assert code == 0, err
+        counts.append(load_dataset(out).spike_count.values)
+    assert not np.array_equal(counts[0], counts[1])
+
+
+def bad_npz(tmp_path):
+    path = tmp_path / "bad.npz"
+    forces = np.ones((5, 2, 3))
+    forces[3, 1, 2] = -1.0
+    np.savez(path, fs=100.0, forces=forces, x_mm=[0.0, 2.0], y_mm=[0.0, 0.0])
+    return path
+
+
+def long_files(tmp_path, forces="time,site,fx,fy,fz\n0,a,0,0,1\n0,c,0,0,1\n"):
+    (tmp_path / "f.csv").write_text(forces)
+    (tmp_path / "s.csv").write_text("site,x_mm,y_mm\na,0,0\nb,2,0\n")
+    return tmp_path / "f.csv", tmp_path / "s.csv"
+
+
+@pytest.mark.parametrize("make_args,match", [
+    (lambda p: ["--scene", bad_npz(p)], r"bad.npz': field 'forces' has a negative normal force -1.0 N at index [3, 1, 2]"),
+    (lambda p: ["--scene", p / "missing.h5"], "missing.h5' does not exist"),
+    (lambda p: ["--scene", long_files(p)[0], "--sites", long_files(p)[1]],
+     "f.csv': column 'site', line 3: site 'c' is not in the sites table"),
+    (lambda p: ["--scene", save_array(p / "a.npz", pad_scene()), "--sites", long_files(p)[1]],
+     "--sites goes with a long .csv --scene"),
+    (lambda p: ["--scene", "birznieks", "--sites", long_files(p)[1]], "--sites goes with a long .csv --scene"),
+    (lambda p: ["--scene", save_array(p / "a.nc", pad_scene()), "--contact", "0,0,2"],
+     "--contact does not apply to a sensor-array scene"),
+    (lambda p: ["--scene", save_array(p / "a.h5", pad_scene()), "--theta-r", "90"],
+     "--theta-r does not apply to a sensor-array scene"),
+    (lambda p: ["--scene", p / "a.mat"], "sensor-array file (.npz, .nc, .h5, .hdf5)"),
+])
+def test_bad_array_scene_exit_2_nothing_written(capsys, tmp_path, make_args, match):
+    out = tmp_path / "o.nc"
+    code, _, err = run(capsys, "simulate", *make_args(tmp_path), "--engine", "direct", "--out", out)
+    assert code == 2 and match in err and err.count("\n") == 1, err
+    assert not out.exists()
