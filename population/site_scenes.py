@@ -24,11 +24,15 @@ Q ramps up in direction ``direction_deg``.  While ``Q < mu_s N`` an annulus
 ``c <= r <= a`` slips, with traction ``mu_s p(r)``, around a stuck disc of
 radius ``c = a (1 - Q / (mu_s N))^(1/3)`` that shrinks from the edge inward,
 where the traction is ``mu_s p0 (sqrt(1 - r^2/a^2) - (c/a) sqrt(1 - r^2/c^2))``.
-At ``Q = mu_s N`` the stick region vanishes: gross slip (the scene's
-``slip_onset_s``).  The contact then slides; its friction falls to
-``mu_k N`` over ``drop_s`` and carries a stick-slip vibration of relative
-amplitude ``vibration`` at ``vibration_hz``, with the sliding traction
-``mu p(r)`` everywhere.  A control scene (``slip=False``) ramps to
+At ``Q = mu_s N`` the stick region vanishes: gross slip (the start of the
+scene's ``slip`` stage).  The contact then slides; its friction falls to
+``mu_k N`` over ``drop_s``, with the sliding traction ``mu p(r)``
+everywhere, and the sliding contact vibrates (stick-slip): both the
+friction and the normal force carry a vibration of relative amplitude
+``vibration`` at ``vibration_hz``.  The vibration is this scene's reading,
+not Cattaneo-Mindlin's: in the DDMM a change of shear *magnitude* above
+2 F_TH moves no AF, so without the normal-force part a slip would reach only
+SA-II.  A control scene (``slip=False``) ramps to
 ``hold_fraction mu_s N`` and holds without slipping.
 """
 
@@ -136,7 +140,7 @@ def _mindlin_traction(r, a, c, mu, p0):
 def incipient_slip(normal_n: float = 2.0, *, mu_s: float = 1.0, mu_k: float = 0.8, load_rate_n_s: float = 4.0,
                    direction_deg: float = 270.0, radius_mm: float = 6.0, pitch_mm: float = 1.0, slip: bool = True,
                    hold_fraction: float = 0.8, preload_s: float = 0.2, slide_s: float = 0.3, drop_s: float = 0.01,
-                   vibration: float = 0.05, vibration_hz: float = 60.0, center_mm=(0.0, 0.0),
+                   vibration: float = 0.05, vibration_hz: float = 100.0, center_mm=(0.0, 0.0),
                    fs: float = DEFAULT_FS, region: str = "", name: str | None = None) -> Scene:
     """A tangential load ramp on a Hertzian contact up to gross slip, or a control that stops short (module docstring).
 
@@ -175,9 +179,10 @@ def incipient_slip(normal_n: float = 2.0, *, mu_s: float = 1.0, mu_k: float = 0.
     if slip:
         after = t >= t_onset
         drop = np.clip((t[after] - t_onset) / drop_s, 0.0, 1.0)
-        mu = mu_s + (mu_k - mu_s) * drop
-        mu = mu * (1.0 + vibration * np.sin(2 * np.pi * vibration_hz * (t[after] - t_onset)))
+        shake = 1.0 + vibration * np.sin(2 * np.pi * vibration_hz * (t[after] - t_onset))
+        mu = (mu_s + (mu_k - mu_s) * drop) * shake
         shear[after] = (pressure / normal_n)[None, :] * (mu * normal_n)[:, None]
+        normal[after] = normal[after] * shake
     rad = np.deg2rad(direction_deg)
     forces = np.empty((t.size, r.size, 3))
     forces[:, :, 0], forces[:, :, 1] = shear * np.cos(rad), shear * np.sin(rad)

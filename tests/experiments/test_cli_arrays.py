@@ -52,7 +52,6 @@ def test_simulate_array_scene_writes_dataset(capsys, tmp_path):
     assert list(load_dataset(out).condition.values) == ["pad"]
 
 
-@pytest.mark.skip(reason="needs multi-site simulate (the lead's parallel work): sites must change who is driven")
 def test_simulate_honours_array_sites(capsys, tmp_path):
     counts = []
     for site in (0, 3):
