@@ -419,7 +419,7 @@ def region_table() -> list:
 
     Examples
     --------
-    >>> row = region_table()[1]
+    >>> row = region_table()[2]
     >>> row["name"], row["kind"], round(row["area_mm2"]), row["frame_deg"]
     ('D2d', 'fingertip', 339, 0.0)
     """
