@@ -189,6 +189,14 @@ def test_region_at_is_the_first_region_containing_the_point(x, y):
     assert label == (containing[0] if containing else "")
 
 
+def test_a_point_on_a_shared_edge_goes_to_the_region_listed_first():
+    y = REGIONS["thenar"].shape.vertices_mm[-1][1]  # the thumb web: palm_distal's proximal edge
+    edge = [v for v in REGIONS["thenar"].shape.vertices_mm if v[1] == y]
+    x = np.mean([v[0] for v in edge])
+    assert REGIONS["palm_distal"].shape.contains(x, y) and REGIONS["thenar"].shape.contains(x, y)
+    assert hand_map.region_at([x], [y])[0] == "palm_distal"
+
+
 @settings(max_examples=20, deadline=None)
 @given(types=st.lists(st.sampled_from(AFFERENT_TYPES), min_size=1, unique=True))
 def test_a_types_counts_do_not_depend_on_the_other_types(types):
