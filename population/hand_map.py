@@ -87,7 +87,8 @@ class Ellipse:
         for key, pair in (("center_mm", self.center_mm), ("semi_axes_mm", self.semi_axes_mm)):
             v = np.asarray(pair, dtype=float)
             if v.shape != (2,) or not np.all(np.isfinite(v)) or (key == "semi_axes_mm" and np.any(v <= 0)):
-                raise ValueError(f"{key} must be two finite numbers{' > 0' if key == 'semi_axes_mm' else ''}, got {pair!r}")
+                need = " > 0" if key == "semi_axes_mm" else ""
+                raise ValueError(f"{key} must be two finite numbers{need}, got {pair!r}")
             object.__setattr__(self, key, tuple(float(c) for c in v))
         object.__setattr__(self, "angle_deg", float(self.angle_deg))
 
