@@ -193,18 +193,33 @@ def _toml_value(value) -> str:
     return repr(float(value)) if isinstance(value, float) else repr(value)  # shortest exact repr
 
 
+def _where_toml(spec) -> list:
+    """The [map] or [region] table of a spec."""
+    if spec.map is not None:
+        regions = [f"regions = {_toml_value(spec.map.regions)}"] if spec.map.regions else []
+        return ["[map]", f"name = {_toml_value(spec.map.name)}", *regions]
+    name = [f"name = {_toml_value(spec.region.name)}"] if spec.region.name else []
+    return ["[region]", f"center_mm = {_toml_value(spec.region.center_mm)}",
+            f"semi_axes_mm = {_toml_value(spec.region.semi_axes_mm)}", *name]
+
+
+def _count_toml(t) -> list:
+    """The count or density line of a type (none when a map sets the counts)."""
+    if t.count is not None:
+        return [f"count = {t.count}"]
+    return [] if t.density_per_cm2 is None else [f"density_per_cm2 = {t.density_per_cm2}"]
+
+
 def spec_to_toml(spec, header: str = "") -> str:
     """TOML text of a spec (the layout `population.spec` reads)."""
     lines = [header.rstrip(), f"name = {_toml_value(spec.name)}", f"description = {_toml_value(spec.description)}",
-             "", "[region]", f"center_mm = {_toml_value(spec.region.center_mm)}",
-             f"semi_axes_mm = {_toml_value(spec.region.semi_axes_mm)}", "", "[current]"]
+             "", *_where_toml(spec), "", "[current]"]
     for f in dataclasses.fields(spec.current):
         value = getattr(spec.current, f.name)
         if value is not None:
             lines.append(f"{f.name} = {_toml_value(value)}")
     for kind, t in spec.types.items():
-        lines += ["", f"[types.{kind}]", f"count = {t.count}" if t.count is not None
-                  else f"density_per_cm2 = {t.density_per_cm2}",
+        lines += ["", f"[types.{kind}]", *_count_toml(t),
                   f"noise_sigma = {_toml_value(t.noise_sigma)}", f"noise_cv = {_toml_value(t.noise_cv)}",
                   f"gain_cv = {_toml_value(t.gain_cv)}",
                   f"theta_t = {_toml_value({k: v for k, v in dataclasses.asdict(t.theta_t).items() if v not in ((), 0.0) or k == 'distribution'})}",

@@ -59,7 +59,8 @@ def register(sub) -> None:
     p = sub.add_parser("info", help="summarise a dataset file")
     p.add_argument("file")
     p.set_defaults(func=run_info)
-    p = sub.add_parser("plot", help="raster, PSTH, polar and force figures of a dataset")
+    p = sub.add_parser("plot", help="raster, PSTH, polar and force figures of a dataset "
+                                    "(and a spike-count hand map when its afferents carry hand-map regions)")
     p.add_argument("file")
     p.add_argument("--out", required=True, metavar="DIR")
     p.set_defaults(func=run_plot)
@@ -187,13 +188,17 @@ def run_info(args) -> int:
 
 
 def write_plots(ds, out_dir) -> list:
-    """Write the standard figures of a dataset; returns the paths."""
+    """Write the standard figures of a dataset (plus ``hand.png`` when it has hand-map regions); returns the paths."""
     from .plotting import plot_forces, plot_polar_counts, plot_psth, plot_raster  # matplotlib is slow to import
 
     out_dir = ensure_out_dir(out_dir)
     bin_s = max(0.005, float(ds.duration.max()) / 100.0)
     figures = {"raster.png": plot_raster(ds), "psth.png": plot_psth(psth(ds, bin_s)),
                "polar.png": plot_polar_counts(ds), "forces.png": plot_forces(ds)}
+    if "region" in ds.coords and any(ds.region.values.astype(str) != ""):  # afferents placed on the hand map
+        from .plot_hand import hand_counts, plot_hand
+
+        figures["hand.png"] = plot_hand(ds, counts=hand_counts(ds))
     return [str(save_figure(fig, out_dir / name)) for name, fig in figures.items()]
 
 

@@ -6,7 +6,8 @@ Schema (names are fixed):
   (events) and ``time`` (force samples);
 * coords on ``afferent``: ``afferent`` (the stable afferent id),
   ``afferent_type``, ``theta_t`` (deg), ``nap``, ``k``, ``gain``, ``x_mm``,
-  ``y_mm``, ``noise_sigma``, ``noise_cv``; on ``condition``: ``condition`` (scene name),
+  ``y_mm``, ``noise_sigma``, ``noise_cv``, ``region`` (hand-map region, ``""``
+  when unknown) and ``frame_deg`` (deg, local digit frame to hand frame); on ``condition``: ``condition`` (scene name),
   ``duration`` (s), ``theta_r`` (deg) with ``has_theta_r`` (1 when the scene
   has one nominal shear direction); ``time`` (s); ``stage`` (labels of the
   scenes' phases, with ``stage_start``/``stage_end(condition, stage)`` in s);
@@ -57,7 +58,8 @@ def model_attrs(population, config) -> dict:
     attrs = {
         "ddmm_version": _version(), "engine": config.engine, "dt": config.dt, "method": config.method,
         "seed": config.seed, "no_shear": config.no_shear, "population": population.name,
-        "frame": "+X radial, +Y distal; theta 0 radial, 90 distal, 180 ulnar, 270 proximal",
+        "frame": "+X radial, +Y distal; theta 0 radial, 90 distal, 180 ulnar, 270 proximal; theta_t in the "
+                 "afferent's local digit frame, frame_deg (counterclockwise) rotates it to the hand frame",
         "f_th": F_TH, "contact_threshold": CONTACT_THRESHOLD, "v_peak": V_PEAK,
         **{f"current_{f.name}": "none" if getattr(cp, f.name) is None else getattr(cp, f.name)
            for f in dataclasses.fields(cp)},
@@ -87,6 +89,10 @@ def _afferent_coords(population, index) -> dict:
         "y_mm": ("afferent", pop.y_mm[index].astype(float), {"units": "mm"}),
         "noise_sigma": ("afferent", pop.noise_sigma[index].astype(float), {"units": "mV/sqrt(ms)"}),
         "noise_cv": ("afferent", pop.noise_cv[index].astype(float), {"units": "sqrt(ms)"}),
+        "region": ("afferent", pop.region[index].astype(object),
+                   {"units": "1", "long_name": "hand-map region (population.hand_map), empty when unknown"}),
+        "frame_deg": ("afferent", pop.frame_deg[index].astype(float),
+                      {"units": "deg", "long_name": "rotation from the local digit frame to the hand frame"}),
     }
     return {k: xr.Variable(*v) for k, v in coords.items()}
 

@@ -1,7 +1,8 @@
 """Sampling a population of afferents from a spec.
 
 `sample_population` returns a `Population`: one array per afferent property,
-ordered SAI, RAI, RAII.  Every afferent carries a stable ``afferent_id``;
+ordered SAI, RAI, RAII, SAII.  With a ``[map]`` each type is placed region by
+region of `population.hand_map` (uniform within a region).  Every afferent carries a stable ``afferent_id``;
 per-afferent random streams (the current noise) are derived from it, so
 splitting a population into chunks, or keeping only some types, never
 changes any afferent's result.
@@ -17,12 +18,13 @@ from models.attenuation import UNTUNED
 from models.currents import AFFERENT_TYPES, CurrentParams
 from models.nap import PROFILE_NAMES, k_from_selectivity, validate_k
 
+from . import hand_map
 from .spec import NAP_CHOICES, AngleDistribution, PopulationSpec, SharpnessDistribution, TypeSpec, load_spec
 
 __all__ = ["Population", "sample_population", "make_population"]
 
 _ARRAYS = ("afferent_type", "theta_t", "nap", "k", "gain", "x_mm", "y_mm", "noise_sigma", "noise_cv",
-           "afferent_id")
+           "afferent_id", "region", "frame_deg")
 
 
 @dataclass(frozen=True, eq=False)
@@ -34,7 +36,8 @@ class Population:
     afferent_type : ndarray of str
         ``"SAI"``, ``"RAI"``, ``"RAII"`` or ``"SAII"``.
     theta_t : ndarray of float
-        Tuning angle in degrees, in [0, 360).
+        Tuning angle in degrees, in [0, 360), in the afferent's local digit
+        frame (+X radial, +Y distal along its digit).
     nap : ndarray of str
         ``"selective"``, ``"broad"``, ``"bipolar"`` or ``"none"`` (untuned).
     k : ndarray of float
@@ -42,13 +45,19 @@ class Population:
     gain : ndarray of float
         Per-afferent multiplier of the current drive (dimensionless).
     x_mm, y_mm : ndarray of float
-        Position on the fingertip in mm (+X radial, +Y distal).
+        Position in mm (+X radial, +Y distal): on the fingertip, or in the
+        hand frame for a population drawn from the hand map.
     noise_sigma : ndarray of float
         Additive current-noise intensity in mV/sqrt(ms).
     noise_cv : ndarray of float
         Drive-proportional noise intensity in sqrt(ms) (see `TypeSpec`).
     afferent_id : ndarray of int64
         Stable identity; noise streams derive from it.
+    region : ndarray of str
+        Hand-map region (`population.hand_map`), ``""`` when unknown.
+    frame_deg : ndarray of float
+        Counterclockwise rotation (deg) from the afferent's local digit frame
+        to the hand frame (0 for D2, the palm and unknown regions).
     current : CurrentParams
         Gains and filter of eqs 1-3 shared by the population.
     name : str
@@ -65,13 +74,19 @@ class Population:
     noise_sigma: np.ndarray
     noise_cv: np.ndarray
     afferent_id: np.ndarray
+    region: np.ndarray = None
+    frame_deg: np.ndarray = None
     current: CurrentParams = field(default_factory=CurrentParams)
     name: str = "custom"
 
     def __post_init__(self):
         n = len(self.afferent_type)
+        if self.region is None:
+            object.__setattr__(self, "region", np.full(n, "", dtype=object))
+        if self.frame_deg is None:
+            object.__setattr__(self, "frame_deg", np.zeros(n))
         for name in _ARRAYS:
-            arr = np.asarray(getattr(self, name))
+            arr = np.asarray(getattr(self, name), dtype=object if name == "region" else None)
             if arr.shape != (n,):
                 raise ValueError(f"population {name} must have shape ({n},), got {arr.shape}")
             arr = arr.copy()
@@ -99,7 +114,10 @@ def _validate_values(pop: Population) -> None:
     bad = sorted(set(pop.nap.tolist()) - set(NAP_CHOICES))
     if bad:
         raise ValueError(f"nap={bad[0]!r} is unknown; allowed: {', '.join(NAP_CHOICES)}")
-    for name in ("theta_t", "gain", "x_mm", "y_mm", "noise_sigma", "noise_cv", "k"):
+    if not all(isinstance(r, str) for r in pop.region.tolist()):
+        bad = next(r for r in pop.region.tolist() if not isinstance(r, str))
+        raise ValueError(f"population region must hold strings ('' when unknown), got {bad!r}")
+    for name in ("theta_t", "gain", "x_mm", "y_mm", "noise_sigma", "noise_cv", "k", "frame_deg"):
         arr = np.asarray(getattr(pop, name), dtype=float)
         if not np.all(np.isfinite(arr)):
             raise ValueError(f"population {name} must be finite")
@@ -148,8 +166,26 @@ def _sample_k(dist: SharpnessDistribution, profile: str, n: int, rng) -> np.ndar
     return np.asarray(k_from_selectivity(values, profile) if dist.of == "theta_a" else validate_k(values, profile))
 
 
-def _sample_type(kind: str, spec: TypeSpec, region, rng) -> dict:
-    n = spec.n_afferents(region)
+def _place_in_ellipse(region, n: int, rng) -> dict:
+    """Uniform in the spec's ellipse (local frame), labelled with its hand-map name."""
+    radius, angle = np.sqrt(rng.uniform(0, 1, n)), rng.uniform(0, 2 * np.pi, n)
+    (cx, cy), (a, b) = region.center_mm, region.semi_axes_mm
+    return {"x_mm": cx + a * radius * np.cos(angle), "y_mm": cy + b * radius * np.sin(angle),
+            "region": np.full(n, region.name, dtype=object), "frame_deg": np.full(n, region.frame_deg)}
+
+
+def _place_on_map(counts: dict, n: int, rng) -> dict:
+    """Region by region (map order), uniform within each, hand frame."""
+    names = [name for name, c in counts.items() for _ in range(c)]
+    if len(names) != n:  # pragma: no cover - counts come from the same map
+        raise ValueError(f"map counts sum to {len(names)}, expected {n}")
+    pts = [hand_map.sample_in_region(name, c, rng) for name, c in counts.items()]
+    xy = np.concatenate(pts) if pts else np.empty((0, 2))
+    return {"x_mm": xy[:, 0], "y_mm": xy[:, 1], "region": np.array(names, dtype=object).reshape(n),
+            "frame_deg": np.array([hand_map.REGIONS[r].frame_deg for r in names], float).reshape(n)}
+
+
+def _sample_type(kind: str, spec: TypeSpec, n: int, place, rng) -> dict:
     nap = np.array(_apportion(spec.nap, n), dtype=object)
     nap = nap[rng.permutation(n)] if n else nap
     k = np.zeros(n)
@@ -160,14 +196,25 @@ def _sample_type(kind: str, spec: TypeSpec, region, rng) -> dict:
         k[idx] = _sample_k(spec.sharpness[profile], profile, idx.size, rng)
     s2 = np.log1p(spec.gain_cv**2)
     gain = rng.lognormal(-s2 / 2.0, np.sqrt(s2), n) if spec.gain_cv > 0 else np.ones(n)
-    radius, angle = np.sqrt(rng.uniform(0, 1, n)), rng.uniform(0, 2 * np.pi, n)
-    (cx, cy), (a, b) = region.center_mm, region.semi_axes_mm
+    where = place(n, rng)
     return {
         "afferent_type": np.full(n, kind, dtype=object), "theta_t": _sample_angles(spec.theta_t, n, rng),
-        "nap": nap, "k": k, "gain": gain, "x_mm": cx + a * radius * np.cos(angle),
-        "y_mm": cy + b * radius * np.sin(angle), "noise_sigma": np.full(n, spec.noise_sigma),
+        "nap": nap, "k": k, "gain": gain, **where, "noise_sigma": np.full(n, spec.noise_sigma),
         "noise_cv": np.full(n, spec.noise_cv),
     }
+
+
+def _placements(spec: PopulationSpec) -> dict:
+    """Per type: (count, placement function)."""
+    if spec.map is None:
+        return {kind: (t.n_afferents(spec.region), lambda n, rng: _place_in_ellipse(spec.region, n, rng))
+                for kind, t in spec.types.items()}
+    by_region = spec.map.counts(spec.types)
+    out = {}
+    for kind in spec.types:
+        counts = {name: c[kind] for name, c in by_region.items()}
+        out[kind] = (sum(counts.values()), lambda n, rng, counts=counts: _place_on_map(counts, n, rng))
+    return out
 
 
 def sample_population(spec, rng=None) -> Population:
@@ -194,15 +241,16 @@ def sample_population(spec, rng=None) -> Population:
     if not isinstance(spec, PopulationSpec):  # pragma: no cover - load_spec guarantees it
         raise TypeError(f"spec must be a PopulationSpec, got {type(spec).__name__}")
     rng = np.random.default_rng(rng)
-    parts = [_sample_type(kind, tspec, spec.region, rng) for kind, tspec in spec.types.items()]
+    placements = _placements(spec)
+    parts = [_sample_type(kind, tspec, *placements[kind], rng) for kind, tspec in spec.types.items()]
     arrays = {name: np.concatenate([p[name] for p in parts]) for name in parts[0]}
     n = len(arrays["theta_t"])
     return Population(**arrays, afferent_id=np.arange(n, dtype=np.int64), current=spec.current, name=spec.name)
 
 
 def make_population(afferent_type, theta_t=0.0, nap=UNTUNED, k=3.0, *, gain=1.0, x_mm=0.0, y_mm=0.0,
-                    noise_sigma=0.0, noise_cv=0.0, current: CurrentParams = CurrentParams(),
-                    name="custom") -> Population:
+                    noise_sigma=0.0, noise_cv=0.0, region="", frame_deg=0.0,
+                    current: CurrentParams = CurrentParams(), name="custom") -> Population:
     """Build a population from explicit per-afferent values (scalars broadcast).
 
     Examples
@@ -217,8 +265,9 @@ def make_population(afferent_type, theta_t=0.0, nap=UNTUNED, k=3.0, *, gain=1.0,
     k = np.where(nap == UNTUNED, 0.0, np.broadcast_to(np.asarray(k, float), (n,)))
     arrays = {name: np.broadcast_to(np.asarray(v, float), (n,)).copy()
               for name, v in (("theta_t", theta_t), ("gain", gain), ("x_mm", x_mm), ("y_mm", y_mm),
-                              ("noise_sigma", noise_sigma), ("noise_cv", noise_cv))}
+                              ("noise_sigma", noise_sigma), ("noise_cv", noise_cv), ("frame_deg", frame_deg))}
+    region = np.array(np.broadcast_to(np.asarray(region, dtype=object), (n,)))
     return Population(afferent_type=types, nap=np.array(nap), k=k, afferent_id=np.arange(n, dtype=np.int64),
-                      current=current, name=name, **arrays)
+                      region=region, current=current, name=name, **arrays)
 
 

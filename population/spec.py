@@ -3,11 +3,13 @@
 A spec is a TOML file or the matching frozen dataclasses.  Unknown keys,
 negative counts, NAP fractions that do not sum to 1 and unknown distributions
 are rejected with a `ValueError` naming the key.  Two presets ship inside the
-package: ``fingertip`` (TouchSim's index-fingertip pad) and ``hand``
-(TouchSim's whole hand).
+package: ``fingertip`` (TouchSim's index-fingertip pad, region ``D2d`` of the
+hand map) and ``hand`` (the glabrous hand of `population.hand_map`).
 
 Frame: +X radial, +Y distal (mm, fingertip frame), so theta = 0 deg is radial,
-90 deg distal, 180 deg ulnar and 270 deg proximal.
+90 deg distal, 180 deg ulnar and 270 deg proximal.  With a ``[map]`` the
+positions are in the hand frame and theta_T in each afferent's local digit
+frame (`population.hand_map`).
 
 TOML layout (every table optional unless marked)::
 
@@ -15,6 +17,11 @@ TOML layout (every table optional unless marked)::
     [region]                       # ellipse in mm
     center_mm = [0.0, 0.0]
     semi_axes_mm = [7.0, 9.0]      # radial, distal
+    name = "D2d"                   # optional: the hand-map region it stands for
+    # or, instead of [region] and of every count / density_per_cm2:
+    # [map]
+    # name = "hand"                # counts from the map's densities (row 16)
+    # regions = ["D2d", "D2m"]     # optional subset (default: every region)
     [current]                      # overrides of models.CurrentParams
     g_sai = 5.367
     [types.SAI]                    # one table per type present
@@ -44,11 +51,15 @@ from models.attenuation import UNTUNED
 from models.currents import AFFERENT_TYPES, CurrentParams
 from models.nap import PROFILE_NAMES
 
+from . import hand_map
+
 __all__ = [
     "NAP_CHOICES",
     "AngleDistribution",
     "SharpnessDistribution",
     "Region",
+    "MapSpec",
+    "MAPS",
     "TypeSpec",
     "PopulationSpec",
     "PRESETS",
@@ -59,6 +70,8 @@ __all__ = [
 #: NAP choices of a population: the three profiles and "none" (untuned, CMM).
 NAP_CHOICES = PROFILE_NAMES + (UNTUNED,)
 PRESETS = ("fingertip", "hand")
+#: Maps a spec may name in ``[map]``.
+MAPS = ("hand",)
 _ANGLE_KINDS = ("uniform", "von_mises", "fixed", "list")
 _SHARP_KINDS = ("fixed", "uniform", "list")
 
@@ -167,12 +180,20 @@ DEFAULT_SHARPNESS = {name: SharpnessDistribution(value=3.0) for name in PROFILE_
 
 @dataclass(frozen=True)
 class Region:
-    """An ellipse on the fingertip (mm): centre and semi-axes along X (radial) and Y (distal)."""
+    """An ellipse on the fingertip (mm): centre and semi-axes along X (radial) and Y (distal).
+
+    ``name`` optionally labels it with the hand-map region it stands for
+    (``"D2d"`` for the fingertip preset); its afferents then carry that
+    region and its ``frame_deg``, while positions stay in this local frame.
+    """
 
     center_mm: tuple = (0.0, 0.0)
     semi_axes_mm: tuple = (7.0, 9.0)
+    name: str = ""
 
     def __post_init__(self):
+        if not isinstance(self.name, str) or (self.name and self.name not in hand_map.REGIONS):
+            _fail("region.name", f"{self.name!r} is not a hand-map region; allowed: '', {', '.join(hand_map.REGIONS)}")
         if len(self.center_mm) != 2 or len(self.semi_axes_mm) != 2:
             _fail("region", "center_mm and semi_axes_mm need two numbers each")
         object.__setattr__(self, "center_mm", tuple(_finite("region.center_mm", v) for v in self.center_mm))
@@ -185,6 +206,46 @@ class Region:
         a, b = self.semi_axes_mm
         return math.pi * a * b / 100.0
 
+    @property
+    def frame_deg(self) -> float:
+        """Rotation (deg) from the local frame to the hand frame: the named region's, else 0."""
+        return hand_map.REGIONS[self.name].frame_deg if self.name else 0.0
+
+
+@dataclass(frozen=True)
+class MapSpec:
+    """Afferents placed by a map of the hand (`population.hand_map`).
+
+    Attributes
+    ----------
+    name : {"hand"}
+        The map.
+    regions : tuple of str
+        Regions to populate, in map order whatever the order given (default:
+        every region).
+    """
+
+    name: str = "hand"
+    regions: tuple = ()
+
+    def __post_init__(self):
+        if self.name not in MAPS:
+            _fail("map.name", f"unknown map {self.name!r}; allowed: {', '.join(MAPS)}")
+        if isinstance(self.regions, str) or not isinstance(self.regions, (tuple, list)):
+            _fail("map.regions", f"must be a list of region names, got {self.regions!r}")
+        for name in self.regions:
+            if name not in hand_map.REGIONS:
+                _fail("map.regions", f"{name!r} is not a region of the map; allowed: {', '.join(hand_map.REGIONS)}")
+        object.__setattr__(self, "regions", tuple(n for n in hand_map.REGIONS if n in self.regions))
+
+    def region_names(self) -> tuple:
+        """The regions populated, in map order."""
+        return self.regions or hand_map.region_names()
+
+    def counts(self, types) -> dict:
+        """Afferents per region and type, {region: {type: count}} (`hand_map.region_counts`)."""
+        return hand_map.region_counts(tuple(types), self.region_names())
+
 
 @dataclass(frozen=True)
 class TypeSpec:
@@ -193,7 +254,8 @@ class TypeSpec:
     Attributes
     ----------
     count : int or None
-        Number of afferents; give this or ``density_per_cm2``.
+        Number of afferents; give this or ``density_per_cm2`` (neither with a
+        ``[map]``, which sets the counts).
     density_per_cm2 : float or None
         Afferents per cm^2 over the spec's region.
     theta_t : AngleDistribution
@@ -227,7 +289,7 @@ class TypeSpec:
     noise_cv: float = 0.0
 
     def __post_init__(self):
-        if (self.count is None) == (self.density_per_cm2 is None):
+        if self.count is not None and self.density_per_cm2 is not None:
             _fail("count", "give exactly one of count and density_per_cm2")
         if self.count is not None and (isinstance(self.count, bool) or not isinstance(self.count, int) or self.count < 0):
             _fail("count", f"must be a whole number >= 0, got {self.count!r}")
@@ -253,6 +315,8 @@ class TypeSpec:
         """Count, or density times the region's area, rounded."""
         if self.count is not None:
             return self.count
+        if self.density_per_cm2 is None:
+            _fail("count", "give exactly one of count and density_per_cm2 (or a [map])")
         return int(round(self.density_per_cm2 * region.area_cm2))
 
 
@@ -267,11 +331,14 @@ class PopulationSpec:
     types : dict
         `TypeSpec` per afferent type (``"SAI"``, ``"RAI"``, ``"RAII"``, ``"SAII"``).
     region : Region
-        Where afferents are placed (uniformly), in mm.
+        Where afferents are placed (uniformly), in mm, when there is no map.
     current : CurrentParams
         Gains and derivative filter of eqs 1-3.
     description : str
         Free text.
+    map : MapSpec or None
+        When given, afferents are placed region by region of the hand map at
+        its densities, and no type gives a count or density.
     """
 
     name: str = "custom"
@@ -279,6 +346,7 @@ class PopulationSpec:
     region: Region = Region()
     current: CurrentParams = CurrentParams()
     description: str = ""
+    map: MapSpec | None = None
 
     def __post_init__(self):
         for kind in self.types:
@@ -286,9 +354,21 @@ class PopulationSpec:
                 _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)}")
         ordered = {k: self.types[k] for k in AFFERENT_TYPES if k in self.types}
         object.__setattr__(self, "types", ordered)
+        if self.map is not None and not isinstance(self.map, MapSpec):
+            raise TypeError(f"map must be a MapSpec or None, got {type(self.map).__name__}")
+        for kind, t in ordered.items():
+            given = t.count is not None or t.density_per_cm2 is not None
+            if self.map is not None and given:
+                _fail(f"types.{kind}.count", "a spec with a [map] takes its counts from the map; "
+                      "remove count and density_per_cm2")
+            if self.map is None and not given:
+                _fail(f"types.{kind}.count", "give exactly one of count and density_per_cm2 (or a [map])")
 
     def n_afferents(self) -> dict:
         """Afferents per type."""
+        if self.map is not None:
+            counts = self.map.counts(self.types).values()
+            return {k: sum(c[k] for c in counts) for k in self.types}
         return {k: t.n_afferents(self.region) for k, t in self.types.items()}
 
     def replace(self, **changes) -> "PopulationSpec":
@@ -355,10 +435,13 @@ def spec_from_dict(data: dict, *, default_name: str = "custom") -> PopulationSpe
     for kind in types:
         if kind not in AFFERENT_TYPES:
             _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)}")
+    if "map" in data and "region" in data:
+        _fail("region", "a spec with a [map] places afferents by the map; remove [region]")
     return _build(PopulationSpec, data, "", {
         "types": lambda d, k: {kind: _type_spec(t, f"types.{kind}") for kind, t in d.items()},
         "region": lambda d, k: _build(Region, d, "region"),
         "current": lambda d, k: _build(CurrentParams, d, "current"),
+        "map": lambda d, k: _build(MapSpec, d, "map"),
     })
 
 

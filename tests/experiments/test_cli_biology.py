@@ -50,11 +50,13 @@ def test_bad_decode_options(capsys):
     assert code == 2 and "--train" in err
 
 
-def test_calibrated_spec_round_trips_through_toml():
-    spec = load_spec("fingertip")
+@pytest.mark.parametrize("name", ["fingertip", "hand"])
+def test_calibrated_spec_round_trips_through_toml(name):
+    spec = load_spec(name)
     import tomllib
     again = spec_from_dict(tomllib.loads(spec_to_toml(spec)))
     assert again.current == spec.current and again.n_afferents() == spec.n_afferents()
+    assert again.map == spec.map and again.region == spec.region
     for kind in spec.types:
         assert again.types[kind].nap == pytest.approx(spec.types[kind].nap)
 

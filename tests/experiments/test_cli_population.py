@@ -27,7 +27,8 @@ def test_simulate_info_plot(capsys, tmp_path):
     assert code == 0 and "991 afferents" in text and "birznieks_90" in text
     code, text, _ = run(capsys, "plot", out, "--out", tmp_path / "figs")
     assert code == 0
-    assert {p.name for p in (tmp_path / "figs").iterdir()} == {"raster.png", "psth.png", "polar.png", "forces.png"}
+    assert {p.name for p in (tmp_path / "figs").iterdir()} == {"raster.png", "psth.png", "polar.png", "forces.png",
+                                                             "hand.png"}  # the fingertip is D2d of the hand map
 
 
 def test_plan_prints_skips(capsys):

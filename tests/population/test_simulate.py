@@ -8,7 +8,7 @@ from population import (Contact, birznieks, load_dataset, make_population, plan_
                         sample_population, save_dataset, simulate)
 
 SCHEMA_COORDS = {"afferent", "afferent_type", "theta_t", "nap", "k", "gain", "x_mm", "y_mm", "noise_sigma",
-                 "condition", "duration", "theta_r", "has_theta_r", "trial", "time"}
+                 "region", "frame_deg", "condition", "duration", "theta_r", "has_theta_r", "trial", "time"}
 SCHEMA_VARS = {"spike_count", "spike_time", "spike_afferent", "spike_trial", "spike_condition", "fx", "fy", "fz",
                "stage_start", "stage_end"}
 ATTRS = {"engine", "dt", "method", "seed", "no_shear", "ddmm_version", "f_th", "current_g_sai",
@@ -48,6 +48,19 @@ def test_netcdf_round_trip_is_lossless(small, tmp_path):
     path = save_dataset(ds, tmp_path / "run.nc")
     assert load_dataset(path).identical(ds)
     assert [p.name for p in tmp_path.iterdir()] == ["run.nc"]
+
+
+def test_region_and_frame_round_trip(tmp_path):
+    hand = sample_population("hand", rng=0)
+    pick = np.r_[np.flatnonzero(hand.region == "D1d")[:3], np.flatnonzero(hand.region == "thenar")[:3]]
+    mixed = make_population(["SAI", "RAI"], region=["", "D5m"], frame_deg=[0.0, 14.0])
+    for pop in (hand.select(pick), mixed):
+        ds = simulate(pop, birznieks(90.0), engine="direct", seed=1, quiet=True)
+        np.testing.assert_array_equal(ds.region.values, pop.region)
+        np.testing.assert_array_equal(ds.frame_deg.values, pop.frame_deg)
+        again = load_dataset(save_dataset(ds, tmp_path / "run.nc"))
+        assert again.identical(ds) and again.region.values.tolist() == pop.region.tolist()
+    assert set(hand.select(pick).frame_deg) == {-45.0, 0.0}
 
 
 def test_failed_write_leaves_no_file(small, tmp_path, monkeypatch):

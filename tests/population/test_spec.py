@@ -3,14 +3,22 @@
 import pytest
 
 from experiments.reference import TOUCHSIM_COUNTS
+from population import hand_map
 from population.spec import load_spec, spec_from_dict
 
 
-@pytest.mark.parametrize("name", ["fingertip", "hand"])
-def test_presets_have_touchsim_counts_plus_sa2_at_the_row_16_ratio(name):
-    counts = load_spec(name).n_afferents()
-    assert {k: counts[k] for k in ("SAI", "RAI", "RAII")} == TOUCHSIM_COUNTS[name]
-    assert counts["SAII"] == round(TOUCHSIM_COUNTS[name]["SAI"] * 9 / 70)  # SA-II 9 vs SA-I 70 per cm^2
+def test_fingertip_has_touchsim_counts_plus_sa2_at_the_row_16_ratio():
+    counts = load_spec("fingertip").n_afferents()
+    assert {k: counts[k] for k in ("SAI", "RAI", "RAII")} == TOUCHSIM_COUNTS["fingertip"]
+    assert counts["SAII"] == round(TOUCHSIM_COUNTS["fingertip"]["SAI"] * 9 / 70)  # SA-II 9 vs SA-I 70 per cm^2
+
+
+def test_hand_preset_is_the_hand_map():
+    spec = load_spec("hand")
+    assert spec.map is not None and spec.map.region_names() == hand_map.region_names()
+    by_region = hand_map.region_counts()
+    assert spec.n_afferents() == {t: sum(c[t] for c in by_region.values()) for t in hand_map.TYPES}
+    assert sum(spec.n_afferents().values()) == 12584
 
 
 def test_density_gives_count_over_region():
@@ -39,7 +47,24 @@ BAD = [
     ({"types": {"SAI": {"count": 3, "density_per_cm2": 5.0}}}, "exactly one"),
     ({"types": {}}, "types"),
     ({"types": {"SAI": {"count": 3}}, "region": {"semi_axes_mm": [0.0, 3.0]}}, "semi_axes_mm"),
+    ({"types": {"SAI": {}}}, "types.SAI.count"),
+    ({"types": {"SAI": {"count": 3}}, "region": {"name": "D9d"}}, "region.name"),
+    ({"types": {"SAI": {}}, "map": {"name": "foot"}}, "map.name"),
+    ({"types": {"SAI": {}}, "map": {"regions": ["D2d", "elbow"]}}, "map.regions.*elbow"),
+    ({"types": {"SAI": {}}, "map": {"regions": "D2d"}}, "map.regions"),
+    ({"types": {"SAI": {}}, "map": {"shape": "ellipse"}}, "map.shape"),
+    ({"types": {"SAI": {"count": 3}}, "map": {}}, "types.SAI.count.*map"),
+    ({"types": {"SAI": {"density_per_cm2": 3.0}}, "map": {}}, "types.SAI.count.*map"),
+    ({"types": {"SAI": {}}, "map": {}, "region": {}}, "region.*map"),
 ]
+
+
+def test_map_subset_counts_and_fingertip_region_name():
+    spec = spec_from_dict({"types": {"SAI": {}, "SAII": {}}, "map": {"regions": ["D3d", "D2d"]}})
+    assert spec.map.region_names() == ("D2d", "D3d")  # map order
+    counts = hand_map.region_counts(regions=["D2d", "D3d"])
+    assert spec.n_afferents() == {t: counts["D2d"][t] + counts["D3d"][t] for t in ("SAI", "SAII")}
+    assert load_spec("fingertip").region.name == "D2d" and load_spec("fingertip").region.frame_deg == 0.0
 
 
 @pytest.mark.parametrize("data,match", BAD)

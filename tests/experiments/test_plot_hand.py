@@ -1,0 +1,53 @@
+"""The hand-map figure: outlines, afferents by type, spike-count map; bad input named."""
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+from experiments.plot_hand import hand_counts, plot_hand
+from population import birznieks, hand_map, make_population, sample_population, simulate
+
+
+@pytest.fixture(scope="module")
+def hand():
+    return sample_population("hand", rng=0)
+
+
+def test_outlines_and_one_scatter_per_type(hand):
+    fig = plot_hand(hand)
+    ax = fig.axes[0]
+    assert isinstance(fig, Figure) and len(ax.lines) == len(hand_map.REGIONS)
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels == [f"{k} ({n})" for k, n in hand.counts().items()]
+    assert sum(len(c.get_offsets()) for c in ax.collections) == len(hand)
+    x0, x1 = ax.get_xlim()
+    assert x0 < hand.x_mm.min() and x1 > hand.x_mm.max()
+
+
+def test_counts_set_marker_sizes_and_silent_afferents_are_grey(hand):
+    pop = hand.select(np.flatnonzero(np.isin(hand.region, ["D2d", "D2m"])))
+    counts = np.zeros(len(pop))
+    counts[:10] = np.arange(1, 11)
+    ax = plot_hand(pop, counts=counts).axes[0]
+    silent, *active = ax.collections
+    assert len(silent.get_offsets()) == len(pop) - 10
+    sizes = np.concatenate([c.get_sizes() for c in active])
+    assert sizes.size == 10 and sizes.max() == pytest.approx(41.0)
+    assert ax.get_ylim()[1] < 20.0  # zoomed on the regions present
+
+
+def test_draws_into_a_given_axes_and_takes_a_dataset():
+    pop = make_population(["SAI", "RAI"], region=["D2d", "D2d"], y_mm=[0.0, 2.0])
+    ds = simulate(pop, birznieks(90.0), engine="direct", seed=1, quiet=True)
+    ax = Figure().subplots()
+    assert plot_hand(ds, counts=hand_counts(ds), ax=ax) is ax.figure
+    assert hand_counts(ds).shape == (2,)
+
+
+def test_bad_input_is_named(hand):
+    with pytest.raises(ValueError, match="counts"):
+        plot_hand(hand, counts=np.ones(3))
+    with pytest.raises(ValueError, match="counts"):
+        plot_hand(hand, counts=-np.ones(len(hand)))
+    with pytest.raises(TypeError, match="population"):
+        plot_hand([1, 2, 3])
