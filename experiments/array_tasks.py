@@ -131,7 +131,7 @@ def run_slip(population="fingertip", seed=0, trials=20, windows_ms=(5, 10, 20), 
 
 def _slip_score(ds, afferents, window_s, slip, onset, train, test) -> dict:
     detector = SlipDetector(window_s)
-    detector.fit(_trials(ds, train), slip, afferents)
+    detector.fit(_trials(ds, train), slip, afferents, onset)
     times = detector.detect(_trials(ds, test))
     return evaluate_slip(times, slip, onset, ds.duration.values)
 

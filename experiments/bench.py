@@ -37,7 +37,10 @@ CASES = {
 }
 #: Cases beyond one process: 100,000 afferents in-process and on 2 local Dask
 #: workers, and the streaming encoder's per-chunk latency.
-EXTRA_CASES = ("scale_100k_inprocess", "scale_100k_2workers", "stream_fingertip", "stream_hand")
+EXTRA_CASES = ("scale_100k_inprocess", "scale_100k_2workers", "stream_fingertip", "stream_hand",
+               "hand_5sites_1s_direct", "fingertip_16taxels_1s_direct")
+#: Multi-site cases and the one-site case each is compared with (same population, same run).
+SITE_BASELINES = {"hand_5sites_1s_direct": "hand_1s_direct", "fingertip_16taxels_1s_direct": "fingertip_1s_direct"}
 DT = 1e-4
 
 
@@ -65,13 +68,16 @@ def run_case(name: str) -> dict:
 
 
 def _population_100k():
-    """The hand preset with every count x 8: 100,152 afferents."""
+    """The hand preset's types with every count x 8 (100,672 afferents), on one ellipse of the hand's area."""
     import dataclasses
 
     from population import load_spec, sample_population
+    from population.spec import Region
 
     spec = load_spec("hand")
-    spec = spec.replace(types={k: dataclasses.replace(t, count=t.count * 8) for k, t in spec.types.items()})
+    counts = spec.n_afferents()
+    spec = spec.replace(map=None, region=Region(center_mm=(0.0, -80.0), semi_axes_mm=(45.0, 95.0)),
+                        types={k: dataclasses.replace(t, count=counts[k] * 8) for k, t in spec.types.items()})
     return sample_population(spec, rng=0)
 
 
@@ -151,8 +157,46 @@ def _stream_case(population: str, seconds: float = 3.0) -> dict:
             "unpaced_p99_ms": round(float(np.percentile(unpaced, 99)) * 1e3, 4)}
 
 
+def _site_scene(population: str, sim_s: float):
+    """The bench's Birznieks forces at five digit tips (hand) or on a 4 x 4 taxel array of 2.5 mm pitch."""
+    import numpy as np
+
+    from population import Scene, Sites, birznieks, taxel_radius
+    from population.hand_map import get_region
+
+    base = birznieks(90.0, hold_s=sim_s - 0.25)
+    f = np.stack([base.fx, base.fy, base.fz], axis=1)
+    if population == "hand":
+        tips = [get_region(f"D{d}d") for d in range(1, 6)]
+        sites = Sites([t.center_mm[0] for t in tips], [t.center_mm[1] for t in tips], 6.0,
+                      region=[t.name for t in tips], site_id=[t.name for t in tips])
+        return Scene.from_sites(np.repeat(f[:, None, :], 5, axis=1), sites, base.fs, "five_tips")
+    grid = (np.arange(4) - 1.5) * 2.5
+    x, y = (a.ravel() for a in np.meshgrid(grid, grid))
+    sites = Sites(x, y, taxel_radius(2.5), region=["D2d"] * 16)
+    return Scene.from_sites(np.repeat(f[:, None, :] / 16, 16, axis=1), sites, base.fs, "taxels16")
+
+
+def _sites_case(name: str) -> dict:
+    """A multi-site case: the whole pipeline on `_site_scene`, after one warm-up."""
+    from population import sample_population, simulate
+
+    population = name.split("_")[0]
+    pop, scene = sample_population(population, rng=0), _site_scene(population, 1.0)
+    simulate(pop, scene, engine="direct", dt=DT, seed=0, quiet=True)
+    start = time.perf_counter()
+    ds = simulate(pop, scene, engine="direct", dt=DT, seed=0, quiet=True)
+    wall = time.perf_counter() - start
+    return {"name": name, "engine": "direct", "n_afferents": len(pop), "sim_s": 1.0, "dt_ms": DT * 1e3,
+            "wall_s": round(wall, 4), "afferent_s_per_wall_s": round(len(pop) / wall, 1),
+            "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
+            "spikes": int(ds.sizes["spike"]), "n_sites": scene.n_sites}
+
+
 def run_extra(name: str) -> dict:
     """Run one of `EXTRA_CASES` in this process."""
+    if name in SITE_BASELINES:
+        return _sites_case(name)
     if name.startswith("scale_100k"):
         return _scale_case(0 if name.endswith("inprocess") else int(name.split("_")[-1][0]))
     return _stream_case(name.split("_", 1)[1])
@@ -211,6 +255,9 @@ def run_bench(cases=None) -> dict:
         ratios["brian2_over_direct_hand_1s"] = round(by["hand_1s_brian2"]["wall_s"] / by["hand_1s_direct"]["wall_s"], 2)
     if "hand_1s_direct" in by:
         ratios["touchsim_hand_over_direct"] = round(TOUCHSIM_SPEED["hand_wall_s"] / by["hand_1s_direct"]["wall_s"], 2)
+    for case, base in SITE_BASELINES.items():
+        if case in by and base in by:
+            ratios[f"{case}_over_{base}"] = round(by[case]["wall_s"] / by[base]["wall_s"], 2)
     if "scale_100k_inprocess" in by and "scale_100k_2workers" in by:
         ratios["speedup_2workers_over_inprocess_100k"] = round(
             by["scale_100k_inprocess"]["wall_s"] / by["scale_100k_2workers"]["wall_s"], 2)

@@ -7,10 +7,10 @@
 * `CentroidClassifier`: a Gaussian classifier with one shared, shrunk
   variance per afferent (the linear discriminant of independent Poisson-like
   counts); it decodes rotation direction or torque magnitude from counts.
-* `SlipDetector`: sums the population's spikes in a sliding window and
-  reports slip when the sum exceeds a threshold learned on no-slip trials
-  (the largest sum any of them reached, times a margin); its latency and
-  false alarms are measured by `evaluate_slip`.
+* `SlipDetector`: in a sliding window, sums each afferent's excess count
+  over what it did in no-slip trials (in units of its own spread) and
+  reports slip when the sum exceeds a threshold learned on no-slip trials;
+  its latency and false alarms are measured by `evaluate_slip`.
 """
 
 from __future__ import annotations
@@ -101,55 +101,83 @@ class CentroidClassifier:
 
 
 class SlipDetector:
-    """Slip reported when the population's spike count in a sliding window exceeds a learned threshold.
+    """Slip reported when the population's surprise in a sliding window exceeds a learned threshold.
+
+    Each afferent's spike count in a sliding window is standardised by what
+    it did in the training no-slip trials, ``z = (count - mean) / max(sd, 0.5)``,
+    and weighted by how much it rose in the training slips' first
+    ``learn_s`` after onset, ``w = max(0, z_slip)`` (a matched filter: FA-II,
+    silent in the controls, weigh most; afferents slips do not move weigh
+    nothing).  The statistic is ``sum w z``; the threshold is ``margin``
+    times its largest value in the training no-slip trials.
 
     Parameters
     ----------
     window_s : float
-        Sliding window in s.
+        Sliding window in s (advanced in quarter steps).
     margin : float
-        Threshold = ``margin`` times the largest windowed count seen in the
-        training no-slip trials (after ``start_stage`` begins).
+        Threshold factor over the no-slip maximum.
     start_stage : str
         Stage from which the detector watches (the tangential load ramp).
+    learn_s : float
+        Span after a training slip's onset that sets the weights, in s.
     """
 
-    def __init__(self, window_s: float = 0.01, margin: float = 1.2, start_stage: str = "tangential_ramp"):
-        if not window_s > 0 or not margin > 0:
-            raise ValueError(f"window_s and margin must be > 0; got {window_s!r} and {margin!r}")
+    def __init__(self, window_s: float = 0.01, margin: float = 1.2, start_stage: str = "tangential_ramp",
+                 learn_s: float = 0.03):
+        if not window_s > 0 or not margin > 0 or not learn_s > 0:
+            raise ValueError(f"window_s, margin and learn_s must be > 0; got {window_s!r}, {margin!r}, {learn_s!r}")
         self.window_s, self.margin, self.start_stage = float(window_s), float(margin), start_stage
+        self.learn_s = float(learn_s)
 
-    def _sums(self, ds, afferents):
-        """Windowed population counts, shape (condition, trial, step of window_s / 4)."""
+    def _windowed(self, ds, afferents, c):
+        """Sliding-window counts of condition ``c``, shape (trial, afferent, step), and each window's end (s)."""
         step = self.window_s / 4
         n_bins = int(np.ceil(float(ds.duration.max()) / step))
-        keep = np.isin(ds.spike_afferent.values, afferents)
+        pos = np.full(ds.sizes["afferent"], -1, np.int64)
+        pos[afferents] = np.arange(afferents.size)
+        keep = (ds.spike_condition.values == c) & (pos[ds.spike_afferent.values] >= 0)
         b = np.minimum((ds.spike_time.values[keep] / step).astype(np.int64), n_bins - 1)
-        binned = np.zeros((ds.sizes["condition"], ds.sizes["trial"], n_bins))
-        np.add.at(binned, (ds.spike_condition.values[keep], ds.spike_trial.values[keep], b), 1)
-        kernel = np.ones(4)
-        sums = np.apply_along_axis(lambda v: np.convolve(v, kernel)[: v.size], 2, binned)
-        return sums, (np.arange(n_bins) + 1) * step  # each sum ends at that time
+        binned = np.zeros((ds.sizes["trial"], afferents.size, n_bins + 3), np.float32)
+        np.add.at(binned, (ds.spike_trial.values[keep], pos[ds.spike_afferent.values[keep]], b + 3), 1)
+        cs = np.cumsum(binned, axis=2)
+        sums = cs[:, :, 3:] - np.concatenate([np.zeros_like(cs[:, :, :1]), cs[:, :, :-4]], axis=2)
+        return sums, (np.arange(n_bins) + 1) * step
 
-    def fit(self, ds, slip, afferents) -> "SlipDetector":
-        """Learn the threshold on the no-slip conditions (``slip`` is a boolean per condition)."""
-        slip = np.asarray(slip, bool)
-        if slip.all():
-            raise ValueError("the detector needs no-slip conditions to learn its threshold")
-        sums, ends = self._sums(ds, afferents)
+    def _statistic(self, sums):
+        z = (sums - self.mean_[None, :, None]) / self.sd_[None, :, None]
+        return np.einsum("i,tij->tj", self.weight_, z)
+
+    def fit(self, ds, slip, afferents, onset) -> "SlipDetector":
+        """Learn the no-slip statistics, the weights and the threshold.
+
+        ``slip`` is a boolean per condition, ``onset`` the slip onset (s) per
+        condition (ignored where ``slip`` is False).
+        """
+        slip, self.afferents_ = np.asarray(slip, bool), np.asarray(afferents, np.int64)
+        if slip.all() or not slip.any():
+            raise ValueError("the detector needs slip and no-slip training conditions")
         start = stage_onset(ds, self.start_stage)
-        watched = ends[None, None, :] >= start[:, None, None] + self.window_s
-        self.threshold_ = self.margin * max(1.0, float(np.max(np.where(watched, sums, 0.0)[~slip])))
-        self.afferents_ = np.asarray(afferents)
+        windows = {c: self._windowed(ds, self.afferents_, c) for c in range(slip.size)}
+        watched = [windows[c][0][:, :, windows[c][1] >= start[c] + self.window_s] for c in np.flatnonzero(~slip)]
+        pooled = np.concatenate([w.transpose(1, 0, 2).reshape(self.afferents_.size, -1) for w in watched], axis=1)
+        self.mean_, self.sd_ = pooled.mean(axis=1), np.maximum(pooled.std(axis=1), 0.5)
+        rises = [windows[c][0][:, :, (windows[c][1] >= onset[c]) & (windows[c][1] < onset[c] + self.learn_s)]
+                 for c in np.flatnonzero(slip)]
+        rise = np.concatenate([r.transpose(1, 0, 2).reshape(self.afferents_.size, -1) for r in rises], axis=1)
+        self.weight_ = np.maximum((rise.mean(axis=1) - self.mean_) / self.sd_, 0.0)
+        self.threshold_ = self.margin * max(1e-9, max(float(self._statistic(w).max()) for w in watched))
         return self
 
     def detect(self, ds) -> np.ndarray:
         """Detection time (s) per (condition, trial), ``inf`` where slip is never reported."""
-        sums, ends = self._sums(ds, self.afferents_)
         start = stage_onset(ds, self.start_stage)
-        hit = (sums > self.threshold_) & (ends[None, None, :] >= start[:, None, None] + self.window_s)
-        first = np.where(hit.any(axis=2), ends[np.argmax(hit, axis=2)], np.inf)
-        return first
+        out = np.full((ds.sizes["condition"], ds.sizes["trial"]), np.inf)
+        for c in range(ds.sizes["condition"]):
+            sums, ends = self._windowed(ds, self.afferents_, c)
+            hit = (self._statistic(sums) > self.threshold_) & (ends >= start[c] + self.window_s)[None, :]
+            out[c] = np.where(hit.any(axis=1), ends[np.argmax(hit, axis=1)], np.inf)
+        return out
 
 
 def evaluate_slip(times, slip, onset, duration) -> dict:

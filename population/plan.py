@@ -135,7 +135,7 @@ class Plan:
                                                        else f"on, {int(np.sum(cond.weights > 0))} afferents in range"))
             noisy = cond.noisy.size
             lines.append(f"    noise: {'on for ' + str(noisy) + ' afferents' if noisy else 'off (skipped)'}")
-            lines.append(f"    quiet (identically zero current, skipped): {cond.n_quiet}")
+            lines.append(f"    quiet (identically zero current, skipped): {cond.n_quiet}" + _by_region(population, self, cond))
             lines.append(f"    integrations: {cond.units.size} deterministic unit(s) for "
                          f"{int(np.sum(cond.member_unit >= 0))} noiseless afferents"
                          + (f" (once for all {self.trials} trials)" if self.trials > 1 else "")
@@ -144,6 +144,16 @@ class Plan:
         lines.append(f"chunks: {self.chunk_size} afferents x {self.time_chunk} samples (~{mb:.0f} MB working set)")
         lines.append("recording: spike_count" + "".join(f", {r}" for r in self.record))
         return "\n".join(lines)
+
+
+def _by_region(population, plan, cond) -> str:
+    """`` (by region: D4d 120, ...)`` when the population carries regions."""
+    regions = population.region[plan.selected[cond.member_unit == -2]]
+    regions = regions[regions != ""]
+    if regions.size == 0:
+        return ""
+    names, counts = np.unique(regions, return_counts=True)
+    return " (by region: " + ", ".join(f"{n} {c}" for n, c in zip(names, counts)) + ")"
 
 
 def _af_note(cond: ConditionPlan) -> str:

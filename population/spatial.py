@@ -21,6 +21,10 @@ the weighted mean of the sites' tractions times A_ref, and its drive is
 scaled by the coverage ``min(S_i, 1)`` (the one-site scene's weight).  Its
 own local shear direction then drives its AF.  A site whose footprint is
 A_ref, alone over an afferent, gives F_i = F_s exactly: the one-site scene.
+Site forces are in the population's frame (the hand frame of
+`population.hand_map`), so the AF compares them with each afferent's tuning
+angle turned into that frame, ``theta_T + frame_deg`` (`frame_theta`); a
+one-site scene's force acts in every afferent's own digit frame.
 """
 
 from __future__ import annotations
@@ -32,7 +36,7 @@ from models.currents import AFFERENT_TYPES
 from .scenes import Contact
 
 __all__ = ["RF_AREA_MM2", "RF_SIGMA_MM", "RF_SUPPORT", "REFERENCE_AREA_MM2", "receptive_field_weight",
-           "site_weights", "local_mixing", "site_coverage", "site_drive"]
+           "site_weights", "local_mixing", "site_coverage", "frame_theta", "site_drive"]
 
 #: Median receptive-field area per type in mm^2 (PHYSIOLOGY.md row 17: SA-I, FA-I read (V); SA-II about
 #: 5x and FA-II about 10x larger, read in a secondary source (V2)).
@@ -148,6 +152,16 @@ def site_coverage(population, sites) -> np.ndarray:
     return np.minimum(w.sum(axis=1), 1.0)
 
 
+def frame_theta(population) -> np.ndarray:
+    """Tuning angles (deg) in the population's frame: theta_T (in the afferent's digit frame) + ``frame_deg``.
+
+    Multi-site forces are given in the population's frame; a one-site
+    scene's force acts in every afferent's own digit frame, so it uses
+    theta_T alone.
+    """
+    return population.theta_t + population.frame_deg
+
+
 def site_drive(population, sites, fs: float, no_shear: str):
     """What turns site forces into each afferent's drive: (`FusedPlan`, indptr, indices, coeff).
 
@@ -161,6 +175,6 @@ def site_drive(population, sites, fs: float, no_shear: str):
     pop = population
     indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, sites)
     ones, zeros = np.ones(len(pop)), np.zeros(len(pop))
-    plan = FusedPlan(pop.afferent_type, pop.nap, pop.theta_t, pop.k, ones, zeros, zeros, pop.current, fs, no_shear,
-                     F_TH)
+    plan = FusedPlan(pop.afferent_type, pop.nap, frame_theta(pop), pop.k, ones, zeros, zeros, pop.current, fs,
+                     no_shear, F_TH)
     return plan, indptr, indices, coeff

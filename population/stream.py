@@ -37,7 +37,7 @@ from .noise import draw_noise, noise_streams, root_seed
 from .sampling import Population
 from .scenes import Contact, Sites
 from .simulate import _grouped
-from .spatial import local_mixing, receptive_field_weight, site_coverage
+from .spatial import frame_theta, local_mixing, receptive_field_weight, site_coverage
 
 __all__ = ["StreamSpikes", "Encoder"]
 
@@ -131,7 +131,8 @@ class Encoder:
         elif self.sites is not None:
             scale = pop.gain * site_coverage(pop, self.sites)
             self._mixing = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, self.sites)[:3]
-        self._plan = FusedPlan(pop.afferent_type, pop.nap, pop.theta_t, pop.k, scale, pop.noise_cv, pop.noise_sigma,
+        theta = pop.theta_t if self.sites is None else frame_theta(pop)
+        self._plan = FusedPlan(pop.afferent_type, pop.nap, theta, pop.k, scale, pop.noise_cv, pop.noise_sigma,
                                pop.current, self.fs, self.no_shear, F_TH)
         p = neuron_arrays(pop.afferent_type)
         h, half = 1.0 * self.dt / 0.001, (1.0 * (0.5 * self.dt)) / 0.001  # as run_direct computes them
