@@ -41,7 +41,10 @@ def register(sub) -> None:
     p.add_argument("--out", metavar="DIR", help="write calibrate.json and calibrated_{fingertip,hand}.toml here")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=run_calibrate)
-    p = sub.add_parser("decode", help="decode shear direction from population spikes (vs 7.1 deg)")
+    p = sub.add_parser("decode", help="decode shear direction (vs 7.1 deg), torque or slip from population spikes")
+    p.add_argument("--task", choices=("direction", "torque", "slip"), default="direction",
+                   help="direction (default), torque (torsion scenes) or slip (incipient-slip scenes)")
+    p.add_argument("--trials", type=int, default=20, help="torque and slip: trials per condition, half for training")
     p.add_argument("--population", default="fingertip")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--train", type=int, default=200, help="training trials (directions)")
@@ -126,6 +129,8 @@ def decode_summary(population="fingertip", seed=0, train=200, test=200, subsets=
 
 
 def run_decode(args) -> int:
+    if args.task != "direction":
+        return _run_array_task(args)
     out_dir = ensure_out_dir(args.out) if args.out else None
     summary, best = decode_summary(args.population, args.seed, args.train, args.test, args.subsets, args.engine)
     if args.json:
@@ -146,4 +151,28 @@ def run_decode(args) -> int:
 
         save_json({**summary, "best": best}, out_dir / "decode.json")
         save_figure(plot_neurometric(summary, HUMAN_DIRECTION_THRESHOLD_DEG), out_dir / "neurometric.png")
+    return 0
+
+
+def _run_array_task(args) -> int:
+    """``ddmm decode --task torque|slip``: the protocols of `experiments.array_tasks`."""
+    from .array_tasks import run_slip, run_torque
+
+    if args.trials < 2:
+        raise ValueError(f"--trials must be >= 2 (half train, half test), got {args.trials}")
+    out_dir = ensure_out_dir(args.out) if args.out else None
+    run = run_torque if args.task == "torque" else run_slip
+    result = run(args.population, seed=args.seed, trials=args.trials, subsets=args.subsets, engine=args.engine)
+    if args.json:
+        print(json.dumps(result))
+    else:
+        extra = ("magnitude_accuracy",) if args.task == "torque" else ("latency_ms", "false_alarms_per_s")
+        print(f"# decoding {args.task} [prediction: never fitted]: {result['protocol']}\n")
+        print("| window (ms) | types | n | accuracy | " + " | ".join(extra) + " |\n" + "|---" * (4 + len(extra)) + "|")
+        for r in result["results"]:
+            values = ["-" if r[k] is None else f"{r[k]:.3g}" for k in extra]
+            print(f"| {r['window_ms']} | {'+'.join(r['types'])} | {r['n_afferents']} | {r['accuracy']:.3f} | "
+                  + " | ".join(values) + " |")
+    if out_dir is not None:
+        save_json(result, out_dir / f"decode_{args.task}.json")
     return 0

@@ -71,3 +71,32 @@ def test_calibration_reproduces_the_committed_preset():
     assert spec.types["RAI"].nap["none"] == pytest.approx(committed.types["RAI"].nap["none"], abs=0.01)
     assert np.isclose(report["validation"]["mean_sd"]["tuned_fraction.recorded"][0], 0.86, atol=0.03)
     assert all(v["all_pass"] for v in report["validation"]["scorecard_all_pass"].values())
+
+
+def test_decode_torque_json_shape_and_the_100_ms_claim(capsys):
+    code = main(["decode", "--task", "torque", "--trials", "6", "--subsets", "1", "--json"])
+    out = capsys.readouterr().out
+    assert code == 0
+    result = json.loads(out)
+    assert result["task"] == "torque" and result["role"] == "prediction"
+    row = next(r for r in result["results"] if r["window_ms"] == 100 and len(r["types"]) == 4
+               and r["n_afferents"] == 991)
+    assert set(row) >= {"window_ms", "n_afferents", "types", "accuracy"} and row["accuracy"] >= 0.95
+
+
+def test_decode_slip_json_reports_latency_and_false_alarms(capsys):
+    code = main(["decode", "--task", "slip", "--trials", "4", "--subsets", "1", "--population", "fingertip",
+                 "--json"])
+    result = json.loads(capsys.readouterr().out)
+    assert code == 0 and result["task"] == "slip"
+    assert all({"latency_ms", "false_alarms_per_s", "accuracy"} <= set(r) for r in result["results"])
+    full = [r for r in result["results"] if len(r["types"]) == 4 and r["n_afferents"] == 991]
+    assert all(r["latency_ms"] is not None and r["latency_ms"] < 74.0 for r in full)
+
+
+def test_decode_task_bad_input(capsys):
+    assert main(["decode", "--task", "torque", "--trials", "1"]) == 2
+    assert "--trials must be >= 2" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exc:
+        main(["decode", "--task", "spin"])
+    assert exc.value.code == 2

@@ -136,3 +136,39 @@ def test_bad_sites(pop):
 
 def test_taxel_radius_is_equal_area():
     assert np.isclose(np.pi * taxel_radius(2.5) ** 2, 2.5 ** 2)
+
+
+@pytest.fixture(scope="module")
+def hand():
+    return sample_population("hand", rng=0)
+
+
+def test_a_push_on_d2_leaves_d4_and_the_palm_silent(hand):
+    base = birznieks(90.0)
+    f = np.stack([base.fx, base.fy, base.fz], axis=1)[:, None, :]
+    sc = Scene.from_sites(f, Sites([0.0], [0.0], R_REF, region=["D2d"], site_id=["D2tip"]), base.fs, "d2push")
+    from population import plan_run
+
+    text = plan_run(hand, [sc]).describe(hand, [sc])
+    ds = simulate(hand, sc, engine="direct", seed=0, quiet=True)
+    counts, region, kind = ds.spike_count.values[0, 0], ds.region.values, ds.afferent_type.values
+    far = np.isin(region, ["D4d", "D4m", "D4p", "palm_central", "palm_distal", "thenar", "hypothenar"])
+    assert counts[far & (kind != "SAII")].sum() == 0  # SA-II fire tonically at rest (row 1)
+    assert counts[(region == "D2d") & (kind == "RAI")].sum() > 1000
+    quiet = int(text.split("quiet (identically zero current, skipped): ")[1].split()[0])
+    assert quiet >= np.sum(far & (kind != "SAII")) and "D4d" in text and "palm_central" in text
+
+
+def test_site_forces_act_in_the_hand_frame(hand):
+    # On the thumb (frame_deg -45), hand-frame shear along the thumb's distal axis is local distal shear.
+    thumb = hand.select(np.flatnonzero((hand.region == "D1d") & (hand.afferent_type != "SAII")))
+    frame = float(thumb.frame_deg[0])
+    assert frame != 0.0 and np.all(thumb.frame_deg == frame)
+    local = birznieks(90.0, contact=Contact(float(thumb.x_mm.mean()), float(thumb.y_mm.mean()), 40.0))
+    turned = birznieks(90.0 + frame)
+    f = np.stack([turned.fx, turned.fy, turned.fz], axis=1)[:, None, :]
+    sites = Sites([float(thumb.x_mm.mean())], [float(thumb.y_mm.mean())], 40.0)
+    scale = REFERENCE_AREA_MM2 / sites.area_mm2[0]
+    multi = Scene.from_sites(f / scale, sites, turned.fs, "thumb")
+    np.testing.assert_allclose(population_currents(thumb, multi), population_currents(thumb, local),
+                               rtol=1e-9, atol=1e-9)
