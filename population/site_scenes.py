@@ -17,6 +17,20 @@ singular at the edge, is not used).  On the grid, the cell forces are
 rescaled so that their moment is exactly T.  ``direction = +1`` turns from
 +X toward +Y (anticlockwise looking at the skin, +Z away from the viewer).
 
+**Grasp** (`grasp`), after the grip-lift task of Johansson & Westling
+(1984).  One site on each of two (thumb and index) or five digit tips, in
+the hand frame of `population.hand_map` (each tip's pad centre, a footprint
+of the reference contact area).  Phases: *preload* (the grip force, normal
+at every tip, rises to ``preload_n`` with no load), *loading* (grip and
+load rise in parallel until the load equals the object's weight: lift-off),
+*hold* (static), *replacement* (both fall back to the preload), *release*.
+The load (the weight ``load_n``) is shared equally by the tips and acts on
+each tip's skin along ``load_direction_deg`` in that digit's own frame
+(default 270 deg, proximal), turned into the hand frame by the digit's
+``frame_deg``.  The hold grip per tip is ``safety`` times the slip limit
+``(load_n / n_tips) / mu`` (grip-to-load ratios some 20-60% above the slip
+ratio in that task; recalled, not read).
+
 **Incipient slip** (`incipient_slip`), read after Cattaneo and Mindlin.  A
 Hertzian contact of radius a carries the normal force N with pressure
 ``p(r) = p0 sqrt(1 - r^2/a^2)``, ``p0 = 3 N / (2 pi a^2)``.  A tangential load
@@ -44,7 +58,7 @@ from models._validation import check_positive
 
 from .scenes import DEFAULT_FS, Scene, Sites, Stage, taxel_radius
 
-__all__ = ["contact_grid", "torsion", "incipient_slip"]
+__all__ = ["contact_grid", "torsion", "incipient_slip", "grasp"]
 
 
 def contact_grid(radius_mm: float, pitch_mm: float, *, center_mm=(0.0, 0.0), region: str = ""):
@@ -191,3 +205,39 @@ def incipient_slip(normal_n: float = 2.0, *, mu_s: float = 1.0, mu_k: float = 0.
     stages.append(Stage("slip", t_onset, t_end) if slip else Stage("hold", t_onset, t_end))
     label = name or f"{'slip' if slip else 'noslip'}_{normal_n:g}N_{load_rate_n_s:g}Nps"
     return Scene.from_sites(forces, sites, fs, label, tuple(stages), direction_deg)
+
+
+def grasp(digits=("D1", "D2"), *, load_n: float = 2.0, mu: float = 1.0, safety: float = 1.4,
+          preload_n: float = 0.3, load_direction_deg: float = 270.0, preload_s: float = 0.1,
+          loading_s: float = 0.3, hold_s: float = 1.0, replace_s: float = 0.3, release_s: float = 0.1,
+          fs: float = DEFAULT_FS, name: str | None = None) -> Scene:
+    """Grip-lift-hold-replace with one site on each digit tip (module docstring); forces in N, times in s.
+
+    Examples
+    --------
+    >>> s = grasp(("D1", "D2", "D3", "D4", "D5"))
+    >>> s.n_sites, [st.label for st in s.stages][:3]
+    (5, ['preload', 'loading', 'hold'])
+    """
+    from .hand_map import get_region
+    from .spatial import REFERENCE_AREA_MM2
+
+    tips = [get_region(f"{d}d") for d in digits]
+    for value, label in ((load_n, "load_n"), (mu, "mu"), (safety, "safety"), (preload_n, "preload_n")):
+        check_positive(value, label, "N or 1")
+    n = len(tips)
+    grip = max(safety * (load_n / n) / mu, preload_n)
+    knots = np.cumsum([0.0, preload_s, loading_s, hold_s, replace_s, release_s])
+    t = np.arange(int(round(knots[-1] * fs))) / fs
+    normal = np.interp(t, knots, [0.0, preload_n, grip, grip, preload_n, 0.0])
+    load = np.interp(t, knots, [0.0, 0.0, load_n, load_n, 0.0, 0.0]) / n
+    forces = np.empty((t.size, n, 3))
+    for j, tip in enumerate(tips):
+        rad = np.deg2rad(load_direction_deg + tip.frame_deg)
+        forces[:, j, 0], forces[:, j, 1], forces[:, j, 2] = load * np.cos(rad), load * np.sin(rad), normal
+    radius = float(np.sqrt(REFERENCE_AREA_MM2 / np.pi))
+    sites = Sites([tip.center_mm[0] for tip in tips], [tip.center_mm[1] for tip in tips], radius,
+                  region=[tip.name for tip in tips], site_id=[tip.name for tip in tips])
+    labels = ("preload", "loading", "hold", "replacement", "release")
+    stages = tuple(Stage(lab, float(a), float(b)) for lab, a, b in zip(labels, knots[:-1], knots[1:]))
+    return Scene.from_sites(forces, sites, fs, name or f"grasp_{n}digits_{load_n:g}N", stages)

@@ -43,7 +43,7 @@ def test_csv_without_sites_keeps_the_single_site_reader(capsys, tmp_path):
 
 
 def test_simulate_array_scene_writes_dataset(capsys, tmp_path):
-    """End to end through today's simulate (which drives the population with the sites' total force)."""
+    """End to end: an array file through ``ddmm simulate`` into a dataset."""
     path = save_array(tmp_path / "pad.npz", pad_scene())
     out = tmp_path / "run.nc"
     code, text, err = run(capsys, "simulate", "--scene", path, "--engine", "direct", "--types", "SAI",
@@ -97,3 +97,21 @@ def test_bad_array_scene_exit_2_nothing_written(capsys, tmp_path, make_args, mat
     code, _, err = run(capsys, "simulate", *make_args(tmp_path), "--engine", "direct", "--out", out)
     assert code == 2 and match in err and err.count("\n") == 1, err
     assert not out.exists()
+
+
+def test_a_16_taxel_fingertip_array_runs_end_to_end(capsys, tmp_path):
+    """A 4 x 4 taxel array of 2.5 mm pitch on the pad, pressed and sheared at its top rows only."""
+    grid = (np.arange(4) - 1.5) * 2.5
+    x, y = (a.ravel() for a in np.meshgrid(grid, grid))
+    forces = np.zeros((300, 16, 3))
+    top = y > 0
+    forces[50:250, top, 2], forces[50:250, top, 1] = 0.4, 0.1
+    path = save_array(tmp_path / "taxels.nc", Scene.from_sites(forces, Sites(x, y, 2.5 / np.sqrt(np.pi)), fs=1000.0))
+    out = tmp_path / "taxels_run.nc"
+    code, _, err = run(capsys, "simulate", "--scene", path, "--engine", "direct", "--quiet", "--out", out)
+    assert code == 0, err
+    ds = load_dataset(out)
+    assert ds.sizes["site"] == 16 and ds.site_radius_mm.attrs["units"] == "mm"
+    counts = ds.spike_count.values[0, 0]
+    sai = ds.afferent_type.values == "SAI"
+    assert counts[sai & (ds.y_mm.values > 4)].mean() > 5 * max(counts[sai & (ds.y_mm.values < -4)].mean(), 0.1)

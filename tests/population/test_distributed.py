@@ -35,6 +35,15 @@ def test_bit_identical_to_in_process(client, pop, engine):
         assert ds.identical(ref)
 
 
+def test_multi_site_runs_are_identical_on_workers(client, pop):
+    from population.site_scenes import torsion
+
+    scenes = [torsion(5.0, 3.0, direction=d, hold_s=0.1, name=f"t{d}") for d in (1, -1)]
+    ref = simulate(pop, scenes, engine="direct", seed=4, trials=2, quiet=True)
+    ds = simulate(pop, scenes, engine="direct", seed=4, trials=2, quiet=True, chunk_size=60, scheduler=client)
+    assert ds.identical(ref) and ref.spike_count.sum() > 100
+
+
 def test_workers_keep_their_own_brian2_cache(client):
     dirs = client.run(lambda: os.environ.get("DDMM_CACHE_DIR"))
     assert len(set(dirs.values())) == 2 and all("workers" in d for d in dirs.values())

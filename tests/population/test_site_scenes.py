@@ -72,3 +72,22 @@ def test_slip_control_never_slips():
     assert np.hypot(s.fx, s.fy).max() == pytest.approx(1.6)
     with pytest.raises(ValueError, match="mu_k <= mu_s"):
         incipient_slip(2.0, mu_s=0.5, mu_k=0.8)
+
+
+def test_grasp_shares_the_load_and_grips_above_the_slip_limit():
+    from population.hand_map import get_region
+    from population.site_scenes import grasp
+
+    s = grasp(("D1", "D2", "D3", "D4", "D5"), load_n=2.5, mu=0.8, safety=1.4)
+    f = s.site_forces
+    hold = slice(int(0.5 * s.fs), int(1.3 * s.fs))
+    tangential = np.hypot(f[hold, :, 0], f[hold, :, 1])
+    np.testing.assert_allclose(tangential.sum(axis=1), 2.5, rtol=1e-12)  # the weight, shared
+    np.testing.assert_allclose(f[hold, :, 2] * 0.8 / tangential, 1.4, rtol=1e-12)  # grip/load over slip ratio
+    # each tip's load acts proximally in its own digit frame
+    for j, d in enumerate(["D1", "D2", "D3", "D4", "D5"]):
+        angle = np.rad2deg(np.arctan2(f[hold, j, 1], f[hold, j, 0]))[0]
+        assert np.isclose((angle - get_region(f"{d}d").frame_deg) % 360.0, 270.0)
+    assert [st.label for st in s.stages] == ["preload", "loading", "hold", "replacement", "release"]
+    with pytest.raises(ValueError):
+        grasp(("D9",))
