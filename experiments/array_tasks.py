@@ -50,8 +50,18 @@ def slip_scenes(rates=SLIP_RATES_N_S, normal_n: float = 2.0) -> list:
     return [incipient_slip(normal_n, load_rate_n_s=r, slip=s) for r in rates for s in (True, False)]
 
 
+def _sizes(sizes, available: int) -> list:
+    """The population sizes that fit, each once (None: all ``available``)."""
+    out = []
+    for size in sizes:
+        n = available if size is None else size
+        if n <= available and n not in out:
+            out.append(n)
+    return out
+
+
 def _subsets(positions, size, n_subsets, rng) -> list:
-    if size is None or size >= positions.size:
+    if size >= positions.size:
         return [positions]
     return [rng.choice(positions, size, replace=False) for _ in range(n_subsets)]
 
@@ -82,12 +92,10 @@ def run_torque(population="fingertip", seed=0, trials=20, windows_ms=(25, 50, 10
         counts = onset_counts(ds, onset, window / 1e3)
         for types in TYPE_SETS:
             positions = np.flatnonzero(np.isin(ds.afferent_type.values, types))
-            for size in sizes:
-                if size is not None and size > positions.size:
-                    continue
+            for size in _sizes(sizes, positions.size):
                 acc = [_accuracy(counts[:, :, sub], label, train, test)
                        for sub in _subsets(positions, size, subsets, rng) for label in (direction, magnitude)]
-                results.append({"window_ms": window, "n_afferents": int(size or positions.size),
+                results.append({"window_ms": window, "n_afferents": int(size),
                                 "types": list(types), "accuracy": float(np.mean(acc[0::2])),
                                 "magnitude_accuracy": float(np.mean(acc[1::2]))})
     return {"task": "torque", "results": results, "role": "prediction", "chance": {"accuracy": 0.5,
@@ -116,12 +124,10 @@ def run_slip(population="fingertip", seed=0, trials=20, windows_ms=(5, 10, 20), 
     for window in windows_ms:
         for types in TYPE_SETS:
             positions = np.flatnonzero(np.isin(ds.afferent_type.values, types))
-            for size in sizes:
-                if size is not None and size > positions.size:
-                    continue
+            for size in _sizes(sizes, positions.size):
                 scores = [_slip_score(ds, sub, window / 1e3, slip, onset, train, test)
                           for sub in _subsets(positions, size, subsets, rng)]
-                results.append({"window_ms": window, "n_afferents": int(size or positions.size),
+                results.append({"window_ms": window, "n_afferents": int(size),
                                 "types": list(types), **_mean_scores(scores)})
     return {"task": "slip", "results": results, "role": "prediction",
             "human_reference": {"grip_response_ms": HUMAN_SLIP_RESPONSE_MS, "source": "Johansson & Westling 1987"},
