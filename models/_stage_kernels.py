@@ -10,7 +10,9 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-__all__ = ["filter_sections", "stage_tail", "stage_kernel", "smooth_kernel", "transduce_inplace"]
+from .rng import normal
+
+__all__ = ["filter_sections", "stage_tail", "receptor_noise_keyed", "stage_kernel", "smooth_kernel", "transduce_inplace"]
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -83,11 +85,28 @@ def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, t
             x[j] = gain[j] * abs(x[j])
     if noisy:
         for j in range(lo, hi):
-            d = x[j]
-            d = d + d * (normals[j, col] * cv_scale[j])
-            if not signed and d < 0.0:
-                d = 0.0
-            x[j] = d
+            x[j] = _noisy(x[j], normals[j, col], cv_scale[j], signed)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _noisy(d, xi, cv_scale, signed):
+    """Receptor noise on the drive d: ``d (1 + cv xi)``, rectified unless ``signed``."""
+    d = d + d * (xi * cv_scale)
+    if not signed and d < 0.0:
+        d = 0.0
+    return d
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def receptor_noise_keyed(x, lo, hi, key, afferent_id, sample, cv_scale, signed):
+    """`stage_tail`'s receptor noise with each draw made on demand (`models.rng.normal`), in place on ``x``.
+
+    An undriven afferent (d = 0) keeps d = 0 whatever its draw, so its draw is
+    never made: the same bits as drawing it, at no cost.
+    """
+    for j in range(lo, hi):
+        if x[j] != 0.0 and cv_scale[j] != 0.0:
+            x[j] = _noisy(x[j], normal(key, afferent_id[j], sample), cv_scale[j], signed)
 
 
 @nb.njit(cache=True, nogil=True)

@@ -29,11 +29,14 @@ import math
 import numba as nb
 import numpy as np
 
-from ._stage_kernels import filter_sections, stage_tail, transduce_inplace
+from ._stage_kernels import filter_sections, receptor_noise_keyed, stage_tail, transduce_inplace
 from .attenuation import UNTUNED, profile_value
 from .currents import _stage_constants
-from .direct import _integrate_range
+from .direct import _BLOCK, _METHOD_CODES, _integrate_range
+from .engines import NeuronState, check_integration, check_stability, integrate, substeps_for
 from .nap import get_profile, tip_radius
+from .neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
+from .rng import normal
 
 __all__ = ["FusedPlan", "mix_forces"]
 
@@ -64,7 +67,7 @@ def _shear(fx, fy, two_fth):
 def _drive(aff_f, j, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value, f_th, opponent):
     """Afferent ``j``'s drive in newtons: F_A = AF F_Z, or SA-II's stretch (`stretch_drive`)."""
     p = 1.0
-    if tuned and mag > 0.0:
+    if tuned and mag > 0.0 and (smooth_reading or stretch or mag > f_th):
         p = profile_value(ux, uy, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j], aff_f[_P1, j], aff_f[_P2, j],
                           aff_f[_P3, j], aff_f[_P4, j], aff_f[_P5, j], aff_f[_TIP, j])
     if stretch:
@@ -96,21 +99,7 @@ def mix_forces(forces, indptr, indices, coeff):
 
 
 @nb.njit(cache=True, nogil=True)
-def _local_drive(local, aff_f, aff_i, grp_i, smooth_reading, outside_value, f_th, opponent):
-    """Drive (n, n_afferents) from each afferent's own force (n, n_afferents, 3)."""
-    n, m = local.shape[0], local.shape[1]
-    out, two_fth = np.empty((n, m)), 2.0 * f_th
-    for i in range(n):
-        for j in range(m):
-            g = aff_i[_GROUP, j]
-            mag, ux, uy, w = _shear(local[i, j, 0], local[i, j, 1], two_fth)
-            out[i, j] = _drive(aff_f, j, grp_i[_TUNED_G, g] != 0, grp_i[_SIGNED, g] != 0, local[i, j, 2], mag, ux,
-                               uy, w, smooth_reading, outside_value, f_th, opponent)
-    return out
-
-
-@nb.njit(cache=True, nogil=True)
-def _front(forces, local, is_local, normals, noisy_any, state, started, aff_f, aff_i, grp_f, grp_i, sos, fs,
+def _front(forces, local, is_local, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f, grp_i, sos, fs,
            smooth_reading, outside_value, f_th, opponent):
     """Force to linear drive (n, n_afferents); ``state`` updated in place.
 
@@ -144,14 +133,16 @@ def _front(forces, local, is_local, normals, noisy_any, state, started, aff_f, a
                 f[j] = f[j] - offset[j]
             filter_sections(f, lo, hi, sos, g, grp_i[_NSEC, g], z)
             stage_tail(f, lo, hi, offset, y1, y2, slow, fs, grp_i[_ORDER, g], grp_f[_ADAPT, g],
-                       grp_f[_ALPHA_ADAPT, g], grp_f[_THRESHOLD, g], gain, normals, i, cv_scale,
-                       noisy_any and grp_i[_NOISY, g] != 0, grp_i[_SIGNED, g] != 0)
+                       grp_f[_ALPHA_ADAPT, g], grp_f[_THRESHOLD, g], gain, _NO_NORMALS, i, cv_scale, False,
+                       grp_i[_SIGNED, g] != 0)
+            if noisy_any and grp_i[_NOISY, g] != 0:
+                receptor_noise_keyed(f, lo, hi, key, ids, sample0 + i, cv_scale, grp_i[_SIGNED, g] != 0)
         out[i] = f
     return out
 
 
 @nb.njit(cache=True, nogil=True)
-def _back(current, normals, additive, state, rows, aff_f, aff_i, grp_f, grp_i):
+def _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i):
     """Low-pass, bias and additive noise of the transduced drive, in place; returns the smallest current."""
     smooth = state[rows + _SMOOTH]
     lowest = np.inf
@@ -163,18 +154,19 @@ def _back(current, normals, additive, state, rows, aff_f, aff_i, grp_f, grp_i):
                 x = smooth[j]
             if grp_f[_BIAS, g] != 0.0:
                 x = x + grp_f[_BIAS, g]
-            if additive:
-                x = x + normals[j, i] * aff_f[_SIGMA, j]  # `noise_current`
+            if additive and aff_f[_SIGMA, j] != 0.0:
+                x = x + normal(key, ids[j], sample0 + i) * aff_f[_SIGMA, j]  # `noise_current`
             current[i, j] = x
             lowest = min(lowest, x)
     return lowest
 
 
 @nb.njit(cache=True, nogil=True)
-def _back_and_integrate(current, normals, additive, state, rows, aff_f, aff_i, grp_f, grp_i, substeps, method, h,
+def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i, substeps,
+                        method, h,
                         half, a, b, c, d, v, u, v_peak, v_floor, block):
     """`_back`, then the direct engine on the current; returns spikes, the smallest current and finiteness."""
-    lowest = _back(current, normals, additive, state, rows, aff_f, aff_i, grp_f, grp_i)
+    lowest = _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i)
     idx, stp = _integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, 0,
                                 v.size)
     finite = True
@@ -208,17 +200,23 @@ class FusedPlan:
     no_shear : {"pass", "block", "smooth"}
     f_th : float
         Shear threshold in newtons.
+    afferent_id : array_like of int, optional
+        Stable ids keying each afferent's noise (default 0..n-1).
 
     Examples
     --------
     >>> from models.currents import CurrentParams
     >>> plan = FusedPlan(["SAI"], ["none"], [0.0], [1.0], [1.0], [0.0], [0.0], CurrentParams(), 1000.0, "pass", 0.1)
-    >>> plan.currents(np.array([[0.0, 0.0, 2.0]]), None, plan.new_state(), False).shape
+    >>> plan.currents(np.array([[0.0, 0.0, 2.0]]), plan.new_state(), False).shape
     (1, 1)
     """
 
-    def __init__(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, params, fs, no_shear, f_th):
+    def __init__(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, params, fs, no_shear, f_th,
+                 afferent_id=None):
         afferent_type, nap = np.asarray(afferent_type), np.asarray(nap)
+        self.afferent_type, self._neuron_cache = afferent_type, {}
+        self.afferent_id = np.ascontiguousarray(np.arange(afferent_type.size) if afferent_id is None else afferent_id,
+                                                dtype=np.int64)
         self.n_afferents, self.fs, self.f_th = afferent_type.size, float(fs), float(f_th)
         self.smooth_reading, self.outside_value = no_shear == "smooth", 1.0 if no_shear == "pass" else 0.0
         self.opponent = float(params.opponent_saii)
@@ -273,50 +271,81 @@ class FusedPlan:
                            st.tau_s is not None, tuned[a], a, b]
         return grp_f, grp_i, sos_all
 
-    def local_drive(self, local) -> np.ndarray:
-        """Drive in newtons (F_A, or SA-II's stretch), shape (n_samples, n_afferents), from each afferent's
-        own force ``local`` (n_samples, n_afferents, 3): the offline multi-site path's first stage."""
-        return _local_drive(local, self.aff_f, self.aff_i, self.grp_i, self.smooth_reading, self.outside_value,
-                            self.f_th, self.opponent)
+    def advance(self, forces, state, sample0, key, neuron, *, dt, method, engine):
+        """One chunk through the whole pipeline: (afferent, step within the chunk, neuron state after).
+
+        ``forces`` and ``key`` as `currents`; ``sample0`` is the chunk's first
+        sample (0 starts the filters at rest on it); ``neuron`` the
+        `NeuronState` before (None: at rest).  The direct engine runs fused
+        (`spikes`) with the seam's checks; other engines get the currents.
+        """
+        started = sample0 > 0
+        if engine != "direct":
+            current = self.currents(forces, state, started, sample0, key)
+            res = integrate(current, fs=self.fs, dt=dt, afferent_type=self.afferent_type, engine=engine,
+                            method=method, state=neuron)
+            return res.afferent, res.step, res.state
+        args = self._neuron_args(dt, method)
+        if neuron is None:
+            v, u = (np.array(x, dtype=float) for x in resting_state(args[5]))
+        else:
+            v, u = neuron.v.copy(), neuron.u.copy()
+        current, afferent, step, lowest, finite = self.spikes(forces, state, started, sample0, key, args, v, u)
+        if method != "euler":
+            check_stability(np.array([lowest]), dt, method)
+        if not finite or afferent.size > 1:
+            check_integration(afferent, step, v, u, current, method, dt)
+        return afferent, step, NeuronState(v, u)
+
+    def _neuron_args(self, dt, method):
+        """The direct engine's arguments for (dt, method), cached (as `models.direct.run_direct` computes them)."""
+        key = (float(dt), method)
+        if key not in self._neuron_cache:
+            p = neuron_arrays(self.afferent_type)
+            h, half = 1.0 * dt / 0.001, (1.0 * (0.5 * dt)) / 0.001
+            self._neuron_cache[key] = (substeps_for(self.fs, dt), _METHOD_CODES[method], h, half, p["a"], p["b"],
+                                       p["c"], p["d"], V_PEAK, V_FLOOR, _BLOCK)
+        return self._neuron_cache[key]
 
     def new_state(self) -> np.ndarray:
         """Filter, offset, difference, adaptation and smoothing state at rest, shape (n_rows, n_afferents)."""
         return np.zeros((self.rows + 5, self.n_afferents))
 
-    def _drive(self, forces, normals, state, started):
-        noisy, is_local = normals is not None, forces.ndim == 3
+    def _drive(self, forces, state, started, sample0, key):
+        noisy, is_local = key is not None, forces.ndim == 3
         drive = _front(_NO_FORCES if is_local else forces, forces if is_local else _NO_LOCAL, is_local,
-                       normals if noisy else _NO_NORMALS, noisy, state, started, self.aff_f, self.aff_i, self.grp_f,
-                       self.grp_i, self.sos, self.fs, self.smooth_reading, self.outside_value, self.f_th,
-                       self.opponent)
+                       np.uint64(key or 0), noisy, self.afferent_id, int(sample0), state, started, self.aff_f,
+                       self.aff_i, self.grp_f, self.grp_i, self.sos, self.fs, self.smooth_reading,
+                       self.outside_value, self.f_th, self.opponent)
         for cols, stage in self.transducers:
             transduce_inplace(drive[:, cols], stage)
         return drive
 
-    def currents(self, forces, normals, state, started):
+    def currents(self, forces, state, started, sample0=0, key=None):
         """Currents (mV/ms), shape (n_samples, n_afferents), of forces in newtons.
 
         ``forces`` is (n_samples, 3), felt by every afferent, or each
-        afferent's own (n_samples, n_afferents, 3) (`mix_forces`).  ``normals`` (shape (n_afferents, n_samples)) or None; ``state`` is
-        updated in place; ``started`` is False on the first chunk.
+        afferent's own (n_samples, n_afferents, 3) (`mix_forces`).
+        ``state`` is updated in place; ``started`` is False on the first
+        chunk, whose first sample is sample ``sample0`` of the scene.  With
+        a stream ``key`` (`models.rng.stream_key`), the noise of sample n of
+        afferent a is ``models.rng.normal(key, a, n)``; None: noise-free.
         """
-        current = self._drive(forces, normals, state, started)
-        noisy = normals is not None
-        _back(current, normals if noisy else _NO_NORMALS, noisy and self.additive, state, self.rows, self.aff_f,
-              self.aff_i, self.grp_f, self.grp_i)
+        current = self._drive(forces, state, started, sample0, key)
+        _back(current, np.uint64(key or 0), key is not None and self.additive, self.afferent_id, int(sample0), state,
+              self.rows, self.aff_f, self.aff_i, self.grp_f, self.grp_i)
         return current
 
-    def spikes(self, forces, normals, state, started, neuron, v, u):
+    def spikes(self, forces, state, started, sample0, key, neuron, v, u):
         """Currents, then the direct engine: (current, afferent, step, smallest current, finite) of the chunk.
 
-        ``neuron`` is (substeps, method code, h, half, a, b, c, d, v_peak,
-        v_floor, block) as `models.direct` takes them; ``v``, ``u`` and
-        ``state`` are updated in place.
+        Arguments as `currents`; ``neuron`` is (substeps, method code, h,
+        half, a, b, c, d, v_peak, v_floor, block) as `models.direct` takes
+        them; ``v``, ``u`` and ``state`` are updated in place.
         """
-        current = self._drive(forces, normals, state, started)
-        noisy = normals is not None
+        current = self._drive(forces, state, started, sample0, key)
         substeps, method, h, half, a, b, c, d, v_peak, v_floor, block = neuron
-        out = _back_and_integrate(current, normals if noisy else _NO_NORMALS, noisy and self.additive, state,
-                                  self.rows, self.aff_f, self.aff_i, self.grp_f, self.grp_i, substeps, method, h,
-                                  half, a, b, c, d, v, u, v_peak, v_floor, block)
+        out = _back_and_integrate(current, np.uint64(key or 0), key is not None and self.additive, self.afferent_id,
+                                  int(sample0), state, self.rows, self.aff_f, self.aff_i, self.grp_f, self.grp_i,
+                                  substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block)
         return (current, *out)

@@ -1,10 +1,11 @@
-"""Per-afferent current-noise streams that do not depend on chunking.
+"""Current noise as a pure function of its key: independent of chunking, order, process and need.
 
-Each (seed, condition, trial, afferent_id) owns one Philox stream whose
-128-bit key *is* that tuple: Philox is counter-based, and distinct keys are
-its designed way to give independent streams (Salmon et al. 2011, the
-Random123 paper; NumPy's `~numpy.random.Philox`).  An afferent's noise is
-therefore the same whichever chunk, worker or subset simulates it.
+The draw of afferent ``a`` at current sample ``n`` of trial ``t`` of
+condition ``c`` under root seed ``s`` is ``models.rng.normal(stream_key(s, c, t), a, n)``:
+Philox-4x32-10 (Salmon et al. 2011, the Random123 paper), a counter-based
+generator, keyed by the tuple, then a ziggurat.  So an afferent's noise is the
+same whichever chunk, worker, subset or streaming encoder simulates it, and
+a draw nobody needs (an undriven afferent's receptor noise) is never made.
 
 Noise is white and Gaussian, one draw per afferent and current sample of
 length h = 1000/fs ms.  Two terms use it:
@@ -20,18 +21,14 @@ length h = 1000/fs ms.  Two terms use it:
 
 from __future__ import annotations
 
-import os
-from concurrent.futures import ThreadPoolExecutor
-
 import numpy as np
 
-__all__ = ["MAX_AFFERENT_ID", "MAX_TRIALS", "MAX_CONDITIONS", "noise_streams", "draw_noise", "noise_current",
-           "root_seed"]
+from models.rng import normals, stream_key
 
-MAX_AFFERENT_ID = 1 << 24
-MAX_TRIALS = 1 << 20
-MAX_CONDITIONS = 1 << 20
-_POOL = ThreadPoolExecutor(max_workers=max(1, min(4, os.cpu_count() or 1)), thread_name_prefix="ddmm-noise")
+__all__ = ["MAX_AFFERENT_ID", "noise_key", "draw_noise", "noise_current", "root_seed"]
+
+#: Afferent ids fill two 32-bit counter words.
+MAX_AFFERENT_ID = 1 << 63
 
 
 def root_seed(seed) -> int:
@@ -51,57 +48,45 @@ def root_seed(seed) -> int:
     return int(seed)
 
 
-def _key(seed: int, condition: int, trial: int, afferent_id: int) -> int:
-    if not (0 <= afferent_id < MAX_AFFERENT_ID and 0 <= trial < MAX_TRIALS and 0 <= condition < MAX_CONDITIONS):
-        raise ValueError(
-            f"noise streams support afferent ids < {MAX_AFFERENT_ID}, trials < {MAX_TRIALS} and "
-            f"conditions < {MAX_CONDITIONS}; got {afferent_id}, {trial}, {condition}"
-        )
-    return (seed << 64) | (condition << 44) | (trial << 24) | afferent_id
-
-
-def noise_streams(seed: int, condition: int, trial: int, afferent_ids) -> list:
-    """One independent Generator per afferent for this condition and trial.
+def noise_key(seed: int, condition: int, trial: int) -> int:
+    """The 64-bit stream key of one (root seed, condition, trial) (`models.rng.stream_key`).
 
     Examples
     --------
-    >>> a = noise_streams(1, 0, 0, [5, 6])
-    >>> b = noise_streams(1, 0, 0, [6])
-    >>> bool(a[1].standard_normal() == b[0].standard_normal())
+    >>> noise_key(1, 0, 0) == noise_key(1, 0, 0) != noise_key(1, 0, 1)
     True
     """
-    return [np.random.Generator(np.random.Philox(key=_key(seed, condition, trial, int(a)))) for a in afferent_ids]
+    return stream_key(seed, condition, trial)
 
 
-def _fill(rows, streams):
-    for row, gen in zip(rows, streams):
-        gen.standard_normal(out=row)  # releases the GIL while filling
+def draw_noise(key: int, afferent_ids, start: int, n_samples: int) -> np.ndarray:
+    """Standard normals of samples ``start .. start + n_samples - 1``, shape (n_afferents, n_samples).
 
+    A pure function: any split of samples or afferents gives the same values.
 
-def draw_noise(streams, n_samples: int) -> np.ndarray:
-    """The next ``n_samples`` standard normal draws per stream, shape (n, n_samples).
-
-    Streams advance, so consecutive calls continue each afferent's sequence.
-    Rows are filled on a small thread pool; each stream is used by one thread.
+    Examples
+    --------
+    >>> k = noise_key(1, 0, 0)
+    >>> bool(np.array_equal(draw_noise(k, [5, 6], 0, 4)[1, 2:], draw_noise(k, [6], 2, 2)[0]))
+    True
     """
-    out = np.empty((len(streams), n_samples))
-    parts = np.array_split(np.arange(len(streams)), _POOL._max_workers)
-    list(_POOL.map(lambda p: _fill(out[p[0]:p[-1] + 1] if p.size else out[:0], streams[p[0]:p[-1] + 1] if p.size else []), parts))
-    return out
+    ids = np.asarray(afferent_ids, dtype=np.int64)
+    if ids.size and (ids.min() < 0):
+        raise ValueError(f"afferent ids must be >= 0, got {int(ids.min())}")
+    return normals(key, ids, start, n_samples)
 
 
-def noise_current(normals, sigma, fs: float) -> np.ndarray:
+def noise_current(normals_, sigma, fs: float) -> np.ndarray:
     """Additive noise current (mV/ms), shape (n_samples, n), from draws of shape (n, n_samples).
 
     ``sigma * normal / sqrt(h)`` with h = 1000/fs ms.  The drive-proportional
-    term (``noise_cv``) is applied inside the current stage
-    (`models.currents.current_core`), before the current's low-pass; both use
-    the afferent's one draw per sample.
+    term (``noise_cv``) is applied inside the current stage; both use the
+    afferent's one draw per sample.
 
     Examples
     --------
     >>> noise_current(np.ones((1, 2)), [2.0], 1000.0).ravel().tolist()
     [2.0, 2.0]
     """
-    out = normals * (np.asarray(sigma, dtype=float) / np.sqrt(1000.0 / fs))[:, None]
+    out = normals_ * (np.asarray(sigma, dtype=float) / np.sqrt(1000.0 / fs))[:, None]
     return out.T

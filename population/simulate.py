@@ -18,19 +18,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from models._validation import check_choice, check_positive
-from models.attenuation import (NO_SHEAR_READINGS, UNTUNED, attenuated_force, attenuation_factor, profile_factor,
-                                stretch_drive)
-from models.currents import check_fs, current_core
-from models.engines import ENGINES, METHODS, integrate, prepare, substeps_for
-from models.fused import mix_forces
+from models.attenuation import F_TH, NO_SHEAR_READINGS
+from models.currents import check_fs
+from models.engines import ENGINES, METHODS, prepare, substeps_for
+from models.fused import FusedPlan, mix_forces
 
-from .noise import draw_noise, noise_current, noise_streams, root_seed
+from .noise import noise_key, root_seed
 from .plan import RECORD_CHOICES, make_plan
 from .sampling import Population
 from .scenes import Scene
-from .spatial import site_drive
+from .spatial import frame_theta, local_mixing
 
-__all__ = ["SimConfig", "ChunkJob", "run_chunk", "simulate", "plan_run", "population_currents"]
+__all__ = ["SimConfig", "ChunkJob", "run_chunk", "simulate", "plan_run", "population_currents", "block_plan",
+           "chunk_forces"]
 
 _PIPELINE = 2  # afferent blocks in flight at once
 
@@ -95,91 +95,42 @@ class ChunkJob:
     weights: np.ndarray | None
 
 
-def _runs(*columns) -> list:
-    """(value, slice) for each run of equal rows (blocks are sorted by type and NAP).
+def block_plan(population, scene, scale, no_shear: str):
+    """The fused plan of a block of afferents (grouped by type) on a scene, and its site mixing (or None).
 
-    ``value`` is the first column's value of the run; several columns split
-    runs wherever any of them changes.
+    A multi-site scene's forces are in the population's frame, so its AF
+    uses ``theta_T + frame_deg`` (`spatial.frame_theta`).
     """
-    values = [np.asarray(c) for c in columns]
-    n = values[0].size
-    if n == 0:
-        return []
-    change = np.zeros(n - 1, bool)
-    for v in values:
-        change |= v[1:] != v[:-1]
-    edges = np.flatnonzero(change) + 1
-    starts = np.concatenate([[0], edges])
-    ends = np.concatenate([edges, [n]])
-    return [(values[0][a], slice(int(a), int(b))) for a, b in zip(starts, ends)]
+    pop = population
+    theta = pop.theta_t if scene.sites is None else frame_theta(pop)
+    plan = FusedPlan(pop.afferent_type, pop.nap, theta, pop.k, scale, pop.noise_cv, pop.noise_sigma, pop.current,
+                     scene.fs, no_shear, F_TH, pop.afferent_id)
+    mixing = None if scene.sites is None else local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, scene.sites)[:3]
+    return plan, mixing
 
 
-def _attenuated(job: ChunkJob, sl: slice, no_shear: str, sites=None) -> np.ndarray:
-    """Each afferent's drive over samples ``sl`` in newtons: F_A, or SA-II's stretch.
-
-    ``sites`` (`spatial.site_drive` of the block) for a multi-site scene:
-    each afferent then feels its own local force.
-    """
-    pop, scene = job.population, job.scene
-    if sites is not None:
-        plan, indptr, indices, coeff = sites
-        return plan.local_drive(mix_forces(scene.site_forces[sl], indptr, indices, coeff))
-    fz = scene.fz[sl]
-    f_a = np.empty((fz.size, len(pop)))
-    for profile, cols in _runs(pop.nap, pop.afferent_type):
-        if pop.afferent_type[cols.start] == "SAII":
-            f_a[:, cols] = _stretch(scene, sl, pop, cols, profile)
-        elif profile == UNTUNED:
-            f_a[:, cols] = fz[:, None]
-        elif not job.af_stage:
-            f_a[:, cols] = job.af_constant * fz[:, None]
-        else:
-            af = attenuation_factor(scene.fx[sl], scene.fy[sl], pop.theta_t[cols], profile, pop.k[cols],
-                                    no_shear=no_shear)
-            f_a[:, cols] = attenuated_force(fz, af)
-    return f_a
-
-
-def _stretch(scene, sl, pop, cols, profile):
-    """SA-II's signed stretch drive (the attenuated shear), zero without shear."""
-    fx, fy = scene.fx[sl], scene.fy[sl]
-    if scene.max_shear() == 0.0:
-        return np.zeros((fx.size, cols.stop - cols.start))
-    af = profile_factor(fx, fy, pop.theta_t[cols], profile, pop.k[cols]) if profile != UNTUNED else 1.0
-    return stretch_drive(fx, fy, np.broadcast_to(af, (fx.size, cols.stop - cols.start)), pop.current.opponent_saii)
-
-
-def _currents(job: ChunkJob, f_a, states: dict, scale, normals=None) -> np.ndarray:
-    """Currents (mV/ms) of the block, with receptor noise when ``normals`` are given."""
-    pop, fs = job.population, job.scene.fs
-    current = np.empty_like(f_a)
-    for i, (kind, cols) in enumerate(_runs(pop.afferent_type)):
-        current[:, cols], states[i] = current_core(
-            f_a[:, cols], fs, kind, pop.current, states.get(i), scale[cols],
-            None if normals is None else normals[cols], pop.noise_cv[cols])
-    if normals is not None and np.any(pop.noise_sigma > 0):
-        current += noise_current(normals, pop.noise_sigma, fs)
-    return current
+def chunk_forces(scene, sl: slice, mixing) -> np.ndarray:
+    """Forces of samples ``sl``: (n, 3) felt by all, or each afferent's own (n, n_afferents, 3)."""
+    if mixing is None:
+        return np.column_stack([scene.fx[sl], scene.fy[sl], scene.fz[sl]])
+    return mix_forces(scene.site_forces[sl], *mixing)
 
 
 def _run_trial(job: ChunkJob, trial: int, config: SimConfig, progress=None):
     pop, scene = job.population, job.scene
     scale = pop.gain if job.weights is None else pop.gain * job.weights
-    streams = noise_streams(config.seed, job.condition, trial, pop.afferent_id) if job.noisy else None
+    plan, mixing = block_plan(pop, scene, scale, config.no_shear)
+    key = noise_key(config.seed, job.condition, trial) if job.noisy else None
     substeps = substeps_for(scene.fs, config.dt)
-    filters, neuron, afferents, steps = {}, None, [], []
-    sites = None if scene.sites is None else site_drive(pop, scene.sites, scene.fs, config.no_shear)
+    state, neuron, afferents, steps = plan.new_state(), None, [], []
     for start in range(0, scene.n_samples, config.time_chunk):
         sl = slice(start, min(scene.n_samples, start + config.time_chunk))
-        normals = None if streams is None else draw_noise(streams, sl.stop - sl.start)
-        current = _currents(job, _attenuated(job, sl, config.no_shear, sites), filters, scale, normals)
-        res = integrate(current, fs=scene.fs, dt=config.dt, afferent_type=pop.afferent_type,
-                        engine=config.engine, method=config.method, state=neuron)
-        neuron = res.state
-        afferents.append(res.afferent)
-        steps.append(res.step + start * substeps)
+        afferent, step, neuron = plan.advance(chunk_forces(scene, sl, mixing), state, start, key, neuron,
+                                              dt=config.dt, method=config.method, engine=config.engine)
+        afferents.append(afferent)
+        steps.append(step + start * substeps)
         if progress is not None:
-            progress(current.size)
+            progress((sl.stop - sl.start) * len(pop))
     return np.concatenate(afferents), np.concatenate(steps)
 
 
@@ -199,10 +150,8 @@ def population_currents(population, scene, *, no_shear: str = "smooth") -> np.nd
         weights = site_coverage(population, scene.sites)
     scale = population.gain if weights is None else population.gain * weights
     order = _grouped(population, np.arange(len(population)), np.arange(len(population)))
-    job = ChunkJob(scene, population.select(order), 0, (0,), False, True, 0.0 if no_shear == "block" else 1.0,
-                   None if weights is None else weights[order])
-    sites = None if scene.sites is None else site_drive(job.population, scene.sites, scene.fs, no_shear)
-    current = _currents(job, _attenuated(job, slice(None), no_shear, sites), {}, scale[order])
+    plan, mixing = block_plan(population.select(order), scene, scale[order], no_shear)
+    current = plan.currents(chunk_forces(scene, slice(None), mixing), plan.new_state(), False)
     out = np.empty_like(current)
     out[:, order] = current
     return out

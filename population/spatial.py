@@ -36,7 +36,7 @@ from models.currents import AFFERENT_TYPES
 from .scenes import Contact
 
 __all__ = ["RF_AREA_MM2", "RF_SIGMA_MM", "RF_SUPPORT", "REFERENCE_AREA_MM2", "receptive_field_weight",
-           "site_weights", "local_mixing", "site_coverage", "frame_theta", "site_drive"]
+           "site_weights", "local_mixing", "site_coverage", "frame_theta"]
 
 #: Median receptive-field area per type in mm^2 (PHYSIOLOGY.md row 17: SA-I, FA-I read (V); SA-II about
 #: 5x and FA-II about 10x larger, read in a secondary source (V2)).
@@ -160,21 +160,3 @@ def frame_theta(population) -> np.ndarray:
     theta_T alone.
     """
     return population.theta_t + population.frame_deg
-
-
-def site_drive(population, sites, fs: float, no_shear: str):
-    """What turns site forces into each afferent's drive: (`FusedPlan`, indptr, indices, coeff).
-
-    ``population`` must be grouped by type (as `simulate`'s blocks are).
-    ``plan.local_drive(mix_forces(forces, indptr, indices, coeff))`` gives
-    the drive in newtons, shape (n_samples, n_afferents).
-    """
-    from models.attenuation import F_TH
-    from models.fused import FusedPlan
-
-    pop = population
-    indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, sites)
-    ones, zeros = np.ones(len(pop)), np.zeros(len(pop))
-    plan = FusedPlan(pop.afferent_type, pop.nap, frame_theta(pop), pop.k, ones, zeros, zeros, pop.current, fs,
-                     no_shear, F_TH)
-    return plan, indptr, indices, coeff

@@ -1,48 +1,34 @@
 """A streaming encoder: live fingertip force in, spikes out, with bounded latency.
 
-`Encoder` keeps the whole pipeline's state between calls: the derivative
-filters, every neuron's (v, u), and each afferent's noise stream.  Because
-the filter is causal and every stage carries its state, the concatenated
-spikes of *any* chunking equal the offline `simulate` run of the whole
-signal with the same seed (condition 0, trial 0), bit for bit.
-
-Each chunk runs through `models.fused.FusedPlan`: two numba passes (force
-to linear drive, then current to spikes) around numpy's transducers, with
-the same arithmetic as the offline stage-by-stage path.
-
-Noise is drawn ahead in blocks (``noise_block`` samples per afferent) from
-the same per-afferent streams as offline, on a background thread while the
-previous block is consumed, so a chunk only slices a ready block and drawing
-(hundreds of ms for a whole hand) never stalls the stream.
+`Encoder` keeps the whole pipeline's state between calls: the filters and
+every neuron's (v, u).  Each chunk runs through `models.fused.FusedPlan`,
+the very plan `simulate` runs offline, and the noise of sample n of
+afferent a is a pure function of (seed, condition 0, trial 0, a, n)
+(`population.noise`), drawn on demand inside the kernel.  So the
+concatenated spikes of *any* chunking equal the offline run of the whole
+signal with the same seed, bit for bit, with no noise drawn ahead, no
+background thread and no queue.
 """
 
 from __future__ import annotations
 
-from collections import deque
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 
 from models._validation import as_finite_array, check_choice, check_positive
-from models.attenuation import F_TH, NO_SHEAR_READINGS
+from models.attenuation import NO_SHEAR_READINGS
 from models.currents import check_fs
-from models.direct import _BLOCK, _METHOD_CODES
-from models.engines import (ENGINES, METHODS, NeuronState, check_integration, check_stability, integrate, prepare,
-                            substeps_for)
-from models.fused import FusedPlan, mix_forces
-from models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
+from models.engines import ENGINES, METHODS, prepare, substeps_for
+from models.fused import mix_forces
 
-from .noise import draw_noise, noise_streams, root_seed
+from .noise import noise_key, root_seed
 from .sampling import Population
 from .scenes import Contact, Sites
-from .simulate import _grouped
-from .spatial import frame_theta, local_mixing, receptive_field_weight, site_coverage
+from .simulate import _grouped, block_plan
+from .spatial import receptive_field_weight, site_coverage
 
 __all__ = ["StreamSpikes", "Encoder"]
-
-_PREFETCH = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ddmm-noise-prefetch")
-
 
 @dataclass(frozen=True)
 class StreamSpikes:
@@ -85,8 +71,6 @@ class Encoder:
         The force sites of a sensor array or multi-digit hand: chunks are
         then (n, n_sites, 3), and each afferent feels its own local force
         (`population.spatial`), as `simulate` does for `Scene.from_sites`.
-    noise_block : int
-        Noise samples drawn ahead per afferent.
 
     Examples
     --------
@@ -98,8 +82,7 @@ class Encoder:
     """
 
     def __init__(self, population, fs: float, *, dt: float = 1e-4, engine: str = "direct", method: str = "euler",
-                 seed=None, no_shear: str = "smooth", contact: Contact | None = None, sites: Sites | None = None,
-                 noise_block: int = 1000):
+                 seed=None, no_shear: str = "smooth", contact: Contact | None = None, sites: Sites | None = None):
         if not isinstance(population, Population):
             raise TypeError(f"population must be a Population, got {type(population).__name__}")
         self.fs = check_positive(fs, "fs", "Hz")
@@ -112,7 +95,7 @@ class Encoder:
         if sites is not None and (not isinstance(sites, Sites) or contact is not None):
             raise TypeError("sites must be a Sites (and then no contact is given), got "
                             f"{type(sites).__name__} with contact={contact!r}")
-        self.seed, self.contact, self.noise_block = root_seed(seed), contact, int(noise_block)
+        self.seed, self.contact = root_seed(seed), contact
         self.sites = sites
         check_fs(self.fs, population.current, tuple(np.unique(population.afferent_type)))
         idx = np.arange(len(population))
@@ -123,79 +106,29 @@ class Encoder:
         self.reset()
 
     def _precompute(self) -> None:
-        """The fused plan's tables (the same values the offline path uses) and the integrator's constants."""
+        """The fused plan (the one `simulate` builds for these afferents) and the site mixing."""
         pop = self._pop
-        scale, self._mixing = pop.gain, None
+        scale = pop.gain
         if self.contact is not None:
             scale = pop.gain * receptive_field_weight(pop.x_mm, pop.y_mm, pop.afferent_type, self.contact)
         elif self.sites is not None:
             scale = pop.gain * site_coverage(pop, self.sites)
-            self._mixing = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, self.sites)[:3]
-        theta = pop.theta_t if self.sites is None else frame_theta(pop)
-        self._plan = FusedPlan(pop.afferent_type, pop.nap, theta, pop.k, scale, pop.noise_cv, pop.noise_sigma,
-                               pop.current, self.fs, self.no_shear, F_TH)
-        p = neuron_arrays(pop.afferent_type)
-        h, half = 1.0 * self.dt / 0.001, (1.0 * (0.5 * self.dt)) / 0.001  # as run_direct computes them
-        self._neuron_args = (self.substeps, _METHOD_CODES[self.method], h, half, p["a"], p["b"], p["c"], p["d"],
-                             V_PEAK, V_FLOOR, _BLOCK)
-        self._b = p["b"]
+        frame = _SitesOnly(self.fs, self.sites)
+        self._plan, self._mixing = block_plan(pop, frame, scale, self.no_shear)
+        noisy = np.any(pop.noise_sigma > 0) or np.any(pop.noise_cv > 0)
+        self._key = noise_key(self.seed, 0, 0) if noisy else None
 
     def reset(self) -> None:
-        """Back to the start: filters unset, neurons at rest, noise streams rewound."""
-        if getattr(self, "_pending", None) is not None:
-            self._pending.result()  # let an in-flight draw finish before its streams are dropped
-        self._pending = None
+        """Back to the start: filters at rest on the next sample, neurons at rest, noise from sample 0."""
         self._state, self._neuron, self._samples, self._last_time = self._plan.new_state(), None, 0, None
-        noisy = np.any(self._pop.noise_sigma > 0) or np.any(self._pop.noise_cv > 0)
-        self._streams = noise_streams(self.seed, 0, 0, self._pop.afferent_id) if noisy else None
-        self._blocks = deque()  # noise drawn ahead, oldest first; rows before _noise_pos are used
-        self._noise_pos = 0
-        if self._streams is not None:
-            self._prefetch(self.noise_block)  # the first block is drawn before the first chunk arrives
 
     def wait_ready(self) -> None:
-        """Block until the noise drawn ahead is ready (call before a real-time loop starts)."""
-        if self._pending is not None:
-            self._blocks.append(self._pending.result())
-            self._pending = None
+        """Nothing to prepare: noise is drawn on demand (kept so real-time loops written for it still run)."""
 
     @property
     def n_samples(self) -> int:
         """Samples consumed since the start (or the last reset)."""
         return self._samples
-
-    def _peek_noise(self, n: int) -> np.ndarray:
-        """The next ``n`` noise rows, drawing ahead as needed but consuming nothing.
-
-        Draws advance the generators, so drawn rows are kept until used: a
-        push that fails later leaves the noise sequence exactly where it was.
-        Blocks are queued, never concatenated (a hand's block is 100 MB).
-        """
-        while sum(b.shape[0] for b in self._blocks) - self._noise_pos < n:
-            if self._pending is None:
-                self._prefetch(max(self.noise_block, n))
-            self._blocks.append(self._pending.result())
-            self._pending = None
-        parts, start, need = [], self._noise_pos, n
-        for block in self._blocks:
-            take = min(need, block.shape[0] - start)
-            parts.append(block[start:start + take])
-            need, start = need - take, 0
-            if need == 0:
-                break
-        ahead = sum(b.shape[0] for b in self._blocks) - self._noise_pos - n
-        if self._pending is None and ahead < self.noise_block:
-            self._prefetch(self.noise_block)  # keep a whole block drawn ahead of the one in use
-        return parts[0] if len(parts) == 1 else np.concatenate(parts)
-
-    def _consume_noise(self, n: int) -> None:
-        self._noise_pos += n
-        while self._blocks and self._noise_pos >= self._blocks[0].shape[0]:
-            self._noise_pos -= self._blocks.popleft().shape[0]
-
-    def _prefetch(self, rows: int) -> None:
-        """Start drawing the next ``rows`` noise samples on the background thread (one draw at a time)."""
-        self._pending = _PREFETCH.submit(lambda: draw_noise(self._streams, rows).T)
 
     def _validate(self, forces, times):
         forces = as_finite_array(forces, "forces")
@@ -240,12 +173,10 @@ class Encoder:
         state = self._state.copy()  # committed only if the whole chunk succeeds
         if self._mixing is not None:
             forces = mix_forces(forces, *self._mixing)  # each afferent's own force, (n, n_afferents, 3)
-        normals = None if self._streams is None else self._peek_noise(n).T
-        afferent, step, v, u = self._run(forces, normals, state)
+        afferent, step, neuron = self._plan.advance(forces, state, self._samples, self._key, self._neuron, dt=self.dt,
+                                                    method=self.method, engine=self.engine)
         step0 = self._samples * self.substeps
-        self._state, self._neuron = state, NeuronState(v, u)
-        if self._streams is not None:
-            self._consume_noise(n)
+        self._state, self._neuron = state, neuron
         self._samples += n
         if times is not None:
             self._last_time = float(times[-1])
@@ -255,22 +186,9 @@ class Encoder:
             afferent, step = afferent[order], step[order]
         return StreamSpikes(afferent, step * self.dt)
 
-    def _run(self, forces, normals, state):
-        """The fused plan on a chunk: spikes and the neurons' new state (the seam's checks, without its set-up)."""
-        started = self._samples > 0
-        if self._neuron is None:
-            v, u = (np.array(x, dtype=float) for x in resting_state(self._b))
-        else:
-            v, u = self._neuron.v.copy(), self._neuron.u.copy()
-        if self.engine != "direct":
-            current = self._plan.currents(forces, normals, state, started)
-            res = integrate(current, fs=self.fs, dt=self.dt, afferent_type=self._pop.afferent_type,
-                            engine=self.engine, method=self.method, state=NeuronState(v, u))
-            return res.afferent, res.step, res.state.v, res.state.u
-        current, afferent, step, lowest, finite = self._plan.spikes(forces, normals, state, started,
-                                                                    self._neuron_args, v, u)
-        if self.method != "euler":
-            check_stability(np.array([lowest]), self.dt, self.method)
-        if not finite or afferent.size > 1:
-            check_integration(afferent, step, v, u, current, self.method, self.dt)
-        return afferent, step, v, u
+
+class _SitesOnly:
+    """What `block_plan` reads of a scene, for an encoder: its sample rate and sites."""
+
+    def __init__(self, fs, sites):
+        self.fs, self.sites = fs, sites

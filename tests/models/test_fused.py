@@ -8,6 +8,7 @@ from hypothesis import strategies as st
 from models.attenuation import UNTUNED, attenuated_force, attenuation_factor, profile_factor, stretch_drive
 from models.currents import CurrentParams, current_core
 from models.fused import FusedPlan
+from models.rng import normals as keyed_normals
 from population import load_spec
 
 FS = 1000.0
@@ -62,11 +63,13 @@ def test_fused_currents_equal_the_stage_by_stage_path(seed, no_shear, physio, no
     cv = np.where(rng.random(n) < 0.7, rng.uniform(0.1, 1.0, n), 0.0)
     sigma = np.where(np.array(TYPES) == "SAII", 0.5, 0.0)
     f = forces(seed)
-    normals = rng.standard_normal((n, f.shape[0])) if noisy else None
+    ids = np.arange(100, 100 + n)
+    key = seed + 1 if noisy else None
+    normals = keyed_normals(key, ids, 0, f.shape[0]) if noisy else None
     expected = reference(f, params, no_shear, scale, cv, sigma, theta, k, normals)
-    plan = FusedPlan(TYPES, NAPS, theta, k, scale, cv, sigma, params, FS, no_shear, 0.1)
+    plan = FusedPlan(TYPES, NAPS, theta, k, scale, cv, sigma, params, FS, no_shear, 0.1, ids)
     state = plan.new_state()
-    parts = [plan.currents(f[a:b], None if normals is None else normals[:, a:b], state, a > 0)
+    parts = [plan.currents(f[a:b], state, a > 0, a, key)
              for a, b in ((0, cut), (cut, f.shape[0]))]  # in two chunks: the state carries over
     np.testing.assert_array_equal(np.concatenate(parts), expected)
 
@@ -76,7 +79,7 @@ def test_fused_plan_needs_no_tuned_afferent():
                      PHYSIO, FS, "smooth", 0.1)
     f = forces(1)
     expected, _ = current_core(np.column_stack([f[:, 2], f[:, 2]]), FS, "RAI", PHYSIO, None, np.ones(2))
-    np.testing.assert_array_equal(plan.currents(f, None, plan.new_state(), False), expected)
+    np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False), expected)
 
 
 @pytest.mark.parametrize("method", ["euler", "rk4"])
@@ -88,13 +91,13 @@ def test_fused_spikes_equal_the_direct_engine(method):
     plan = FusedPlan(TYPES, NAPS, np.linspace(0, 330, len(TYPES)), np.full(len(TYPES), 3.0), np.full(len(TYPES), 2.0),
                      np.zeros(len(TYPES)), np.zeros(len(TYPES)), PHYSIO, FS, "smooth", 0.1)
     f = forces(2)
-    current = plan.currents(f, None, plan.new_state(), False)
+    current = plan.currents(f, plan.new_state(), False)
     res = integrate(current, fs=FS, dt=1e-4, afferent_type=np.array(TYPES), engine="direct", method=method)
     p = neuron_arrays(np.array(TYPES))
     v, u = (np.array(x, dtype=float) for x in resting_state(p["b"]))
     neuron = (10, _METHOD_CODES[method], 1.0 * 1e-4 / 0.001, (1.0 * (0.5 * 1e-4)) / 0.001, p["a"], p["b"], p["c"],
               p["d"], V_PEAK, V_FLOOR, _BLOCK)
-    _, afferent, step, _, finite = plan.spikes(f, None, plan.new_state(), False, neuron, v, u)
+    _, afferent, step, _, finite = plan.spikes(f, plan.new_state(), False, 0, None, neuron, v, u)
     assert finite and afferent.size > 10
     order = np.lexsort((afferent, step))
     np.testing.assert_array_equal(afferent[order], res.afferent)
