@@ -5,8 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from population import load_spec, sample_population, simulate
-from population.tuning import DEFAULT_TRIALS, direction_tuning, tuning_scenes, tuning_summary
+TUNING_TRIALS = 5  # population.tuning.DEFAULT_TRIALS, repeated so that registering the parser imports nothing heavy
 
 from .io import atomic_write, ensure_out_dir, save_figure, save_json
 from .reference import HUMAN_DIRECTION_THRESHOLD_DEG, HUMAN_DSI, HUMAN_TUNED_FRACTION
@@ -28,10 +27,10 @@ TUNING_REFERENCE = {
 
 def register(sub) -> None:
     """Add the tuning, calibrate and decode subcommands."""
-    p = sub.add_parser("tuning", help="direction-tuning statistics against human recordings (~86% tuned)")
+    p = sub.add_parser("tuning", help="direction-tuning statistics against human recordings (~86%% tuned)")
     p.add_argument("--population", default="fingertip")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--trials", type=int, default=DEFAULT_TRIALS, help=f"per condition (default {DEFAULT_TRIALS})")
+    p.add_argument("--trials", type=int, default=TUNING_TRIALS, help=f"per condition (default {TUNING_TRIALS})")
     p.add_argument("--engine", choices=("brian2", "direct"), default="direct")
     p.add_argument("--correction", choices=("none", "bonferroni"), default="none")
     p.add_argument("--out", metavar="DIR")
@@ -56,8 +55,11 @@ def register(sub) -> None:
     p.set_defaults(func=run_decode)
 
 
-def run_tuning_stats(population="fingertip", seed=0, trials=DEFAULT_TRIALS, engine="direct", correction="none"):
+def run_tuning_stats(population="fingertip", seed=0, trials=TUNING_TRIALS, engine="direct", correction="none"):
     """Simulate the five-condition protocol and return (tuning dataset, summary)."""
+    from population import load_spec, sample_population, simulate
+    from population.tuning import direction_tuning, tuning_scenes, tuning_summary
+
     pop = sample_population(load_spec(population), rng=seed)
     ds = simulate(pop, tuning_scenes(), engine=engine, trials=trials, seed=seed, quiet=True)
     tuning = direction_tuning(ds, correction=correction)

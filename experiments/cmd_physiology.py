@@ -5,11 +5,9 @@ from __future__ import annotations
 import json
 import math
 
-from population import load_spec, sample_population
-from population.physiology import PROPERTIES, score_physiology, summarise_scorecard
 
 from .io import ensure_out_dir, save_figure, save_json
-from .reference import HUMAN_DSI, PHYSIOLOGY_REFERENCE
+from .reference import HUMAN_DSI
 
 __all__ = ["register", "run_scorecard", "scorecard_json"]
 
@@ -20,7 +18,7 @@ def register(sub) -> None:
     p.add_argument("--population", default="fingertip", help="fingertip, hand or a spec .toml file")
     p.add_argument("--seed", type=int, default=0, help="population and noise seed (default 0)")
     p.add_argument("--properties", default=None, metavar="NAME[,NAME...]",
-                   help=f"a subset of: {', '.join(PROPERTIES)}")
+                   help="comma-separated property names (default: all; README 'Physiology' lists them)")
     p.add_argument("--engine", choices=("brian2", "direct"), default="direct")
     p.add_argument("--out", metavar="DIR", help="write scorecard.json and one figure per protocol here")
     p.add_argument("--json", action="store_true")
@@ -29,6 +27,11 @@ def register(sub) -> None:
 
 def run_scorecard(population="fingertip", seed=0, properties=None, engine="direct"):
     """Sample the population and score it; returns (rows, protocol data)."""
+    from population import load_spec, sample_population
+    from population.physiology import score_physiology
+
+    from .reference import PHYSIOLOGY_REFERENCE
+
     pop = sample_population(load_spec(population), rng=seed)
     return score_physiology(pop, PHYSIOLOGY_REFERENCE, properties=properties, seed=seed, engine=engine)
 
@@ -65,6 +68,8 @@ def run_physiology(args) -> int:
             print(f"| {r['name']} | {r['type']} | {r['protocol']} | {r['statistic']} | {r['value']:.4g} "
                   f"{'' if r['unit'] == '1' else r['unit']} | {_bound(r)} ({r['mark']}) | {r['role']} | "
                   f"{'pass' if r['pass'] else 'FAIL'} | {r['source']} |")
+        from population.physiology import summarise_scorecard
+
         print("\n" + summarise_scorecard(rows))
     if out_dir is not None:
         from .plot_physiology import physiology_figures

@@ -6,11 +6,6 @@ import time
 import warnings
 from pathlib import Path
 
-from models.engines import SpikeCapWarning
-
-from population import (Contact, birznieks, describe_dataset, from_array, from_csv, from_long_csv, load_dataset,
-                        load_spec, plan_run, press_push_lift, psth, rotating_shear, sample_population,
-                        save_dataset, simulate)
 from population.arrays import EXTENSIONS
 
 from .io import ensure_out_dir, save_figure
@@ -82,6 +77,7 @@ def _directions(text, default="90"):
 
 
 def _contact(text):
+    from population import Contact
     if text is None:
         return None
     try:
@@ -93,6 +89,7 @@ def _contact(text):
 
 def _array_scene(args):
     """The sensor-array scene of ``--scene FILE`` (and ``--sites``), or None for any other ``--scene``."""
+    from population import from_array, from_long_csv
     suffix = Path(args.scene).suffix.lower()
     is_array = suffix in EXTENSIONS or (suffix == ".csv" and args.sites is not None)
     if args.sites is not None and suffix != ".csv":
@@ -108,6 +105,7 @@ def _array_scene(args):
 
 def scenes_from_args(args) -> list:
     """The scenes named by ``--scene``, ``--sites``, ``--theta-r`` and ``--contact``."""
+    from population import birznieks, from_csv, press_push_lift, rotating_shear
     array = _array_scene(args)
     if array is not None:
         return [array]
@@ -133,6 +131,7 @@ def _types(text):
 
 
 def _population(args):
+    from population import load_spec, sample_population
     return sample_population(load_spec(args.population), rng=args.seed)
 
 
@@ -155,6 +154,7 @@ def _check_out_file(path) -> Path:
 
 
 def run_simulate(args) -> int:
+    from population import save_dataset, simulate
     out = _check_out_file(args.out)
     pop, scenes = _population(args), scenes_from_args(args)
     start = time.perf_counter()
@@ -170,6 +170,7 @@ def run_simulate(args) -> int:
 
 
 def run_plan(args) -> int:
+    from population import plan_run
     pop, scenes = _population(args), scenes_from_args(args)
     the_plan = plan_run(pop, scenes, trials=args.trials, no_shear=args.no_shear, types=_types(args.types))
     print(the_plan.describe(pop, scenes))
@@ -183,12 +184,14 @@ def run_plan(args) -> int:
 
 
 def run_info(args) -> int:
+    from population import describe_dataset, load_dataset
     print(describe_dataset(load_dataset(args.file)))
     return 0
 
 
 def write_plots(ds, out_dir) -> list:
     """Write the standard figures of a dataset (plus ``hand.png`` when it has hand-map regions); returns the paths."""
+    from population import psth
     from .plotting import plot_forces, plot_polar_counts, plot_psth, plot_raster  # matplotlib is slow to import
 
     out_dir = ensure_out_dir(out_dir)
@@ -203,6 +206,7 @@ def write_plots(ds, out_dir) -> list:
 
 
 def run_plot(args) -> int:
+    from population import load_dataset
     for path in write_plots(load_dataset(args.file), args.out):
         print(f"wrote {path}")
     return 0
@@ -219,6 +223,8 @@ def register_demo(sub) -> None:
 
 
 def run_demo(args) -> int:
+    from models.engines import SpikeCapWarning
+    from population import describe_dataset, load_spec, press_push_lift, sample_population, save_dataset, simulate
     out_dir = ensure_out_dir(args.out)
     pop = sample_population(load_spec("fingertip"), rng=args.seed)
     scene = press_push_lift(90.0)

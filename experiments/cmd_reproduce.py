@@ -6,13 +6,9 @@ import json
 import sys
 import warnings
 
-from models.currents import PAPER_TYPES
-from models.engines import SpikeCapWarning
 
 from .io import ensure_out_dir, save_figure, save_json
 from .reference import PAPER_TABLE2, PAPER_TABLE3
-from .reproduce import (FIGURE_SCENES, PROFILES, ReproConfig, fig8, reproduce_all, response_data,
-                        table2, table3)
 
 __all__ = ["register", "format_table2", "format_table3", "format_fig8"]
 
@@ -33,6 +29,8 @@ def register(sub) -> None:
 
 def format_table2(result: dict) -> str:
     """Markdown table of our PRSI beside the paper's."""
+    from models.currents import PAPER_TYPES
+    from .reproduce import PROFILES
     prsi = result["prsi"]
     lines = ["| type | " + " | ".join(f"{p} ours (paper)" for p in PROFILES) + " | human DSI |",
              "|---" * (len(PROFILES) + 2) + "|"]
@@ -44,6 +42,8 @@ def format_table2(result: dict) -> str:
 
 def format_table3(result: dict) -> str:
     """Markdown table of our SF at 75/255 deg beside the paper's."""
+    from models.currents import PAPER_TYPES
+    from .reproduce import PROFILES
     sf = result["sf"]
     lines = ["| type | " + " | ".join(f"{p} 75° / 255° ours (paper)" for p in PROFILES) + " |",
              "|---" * (len(PROFILES) + 1) + "|"]
@@ -59,6 +59,8 @@ def format_table3(result: dict) -> str:
 
 def format_fig8(result: dict) -> str:
     """Markdown summary of Fig. 8: peak angle, range and bipolar symmetry."""
+    from models.currents import PAPER_TYPES
+    from .reproduce import PROFILES
     sf = result["sf"]
     lines = ["| profile | type | peak theta_T | SF min-max (pulses/s) | SF(θ) = SF(θ+180°) |",
              "|---|---|---|---|---|"]
@@ -73,6 +75,7 @@ def format_fig8(result: dict) -> str:
 
 
 def _write_figures(out_dir, what, config, result) -> list[str]:
+    from .reproduce import FIGURE_SCENES, PROFILES, response_data
     from .plotting import plot_response, plot_sf_vs_theta  # matplotlib is slow to import
 
     written = []
@@ -91,6 +94,8 @@ def _write_figures(out_dir, what, config, result) -> list[str]:
 
 
 def run(args) -> int:
+    from models.engines import SpikeCapWarning
+    from .reproduce import ReproConfig, fig8, reproduce_all, table2, table3
     config = ReproConfig(engine=args.engine, no_shear=args.no_shear)
     out_dir = ensure_out_dir(args.out) if args.out else None
     compute = {"table2": table2, "table3": table3, "fig8": fig8, "all": reproduce_all}[args.what]

@@ -126,4 +126,12 @@ def _physiology_reference() -> dict:
 
 
 #: Reference ranges of ``ddmm physiology``, by property name.
-PHYSIOLOGY_REFERENCE = _physiology_reference()
+
+
+def __getattr__(name):
+    """``PHYSIOLOGY_REFERENCE`` is built on first use: it needs `population.physiology`, which
+    registering the command line must not import."""
+    if name == "PHYSIOLOGY_REFERENCE":
+        value = globals()["PHYSIOLOGY_REFERENCE"] = _physiology_reference()
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -38,6 +38,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+from ._cache import cache_root
+
 import numpy as np
 
 from .neuron import V_FLOOR
@@ -77,10 +79,7 @@ d : 1
 
 def cache_dir() -> Path:
     """Root of the on-disk Brian2 build cache (``$DDMM_CACHE_DIR`` or ``~/.cache/ddmm``)."""
-    root = os.environ.get("DDMM_CACHE_DIR") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "ddmm"
-    )
-    return Path(root) / "brian2"
+    return cache_root() / "brian2"
 
 
 @dataclass

@@ -55,11 +55,13 @@ Currents are in the Izhikevich model's own units (mV/ms, the units of
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
+from ._cache import cache_root
 from ._stage_kernels import smooth_kernel, stage_kernel, transduce_inplace
 from ._validation import as_finite_array, check_choice, check_positive
 
@@ -367,9 +369,36 @@ def lowpass_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
 
 @lru_cache(maxsize=64)
 def _butter_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
-    from scipy import signal  # scipy.signal is slow to import; only filters need it
+    return _designed("low", order, cutoff_hz, fs)
 
-    return signal.butter(order, cutoff_hz, btype="low", fs=fs, output="sos")
+
+def _designed(btype: str, order: int, cutoff_hz: float, fs: float) -> np.ndarray:
+    """`scipy.signal.butter` sections, kept on disk (``$DDMM_CACHE_DIR/filters``) by their exact arguments.
+
+    Importing scipy.signal costs about 0.4 s, most of a warm start; the
+    cached file holds scipy's own float64 coefficients, so results are the
+    same bits either way.
+    """
+    path = _filter_cache() / f"butter_{btype}_{order}_{float(cutoff_hz).hex()}_{float(fs).hex()}.npy"
+    try:
+        return np.load(path)
+    except (OSError, ValueError):
+        pass
+    from scipy import signal
+
+    sos = signal.butter(order, cutoff_hz, btype=btype, fs=fs, output="sos")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp.npy")
+        np.save(tmp, sos)
+        os.replace(tmp, path)  # atomic: a reader sees the whole file or none
+    except OSError:
+        pass  # a read-only cache only costs the import next time
+    return sos
+
+
+def _filter_cache():
+    return cache_root() / "filters"
 
 
 _PASS_THROUGH = np.array([[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]])  # an identity section: no filter
@@ -388,9 +417,7 @@ def _stage_sos(stage: Stage, fs: float) -> np.ndarray:
 
 @lru_cache(maxsize=16)
 def _highpass_sos(cutoff_hz: float, fs: float) -> np.ndarray:
-    from scipy import signal
-
-    return signal.butter(2, cutoff_hz, btype="high", fs=fs, output="sos")
+    return _designed("high", 2, cutoff_hz, fs)
 
 
 def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams(), afferent_type: str = "RAI"

@@ -18,6 +18,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from functools import lru_cache
+
 import numba as nb
 import numpy as np
 
@@ -215,8 +217,8 @@ def boundary_radius(sin_phi, cos_phi, profile: str | NAPProfile, k) -> np.ndarra
     """
     prof = get_profile(profile)
     k = validate_k(k, prof)
-    r = radius_core(np.asarray(sin_phi, dtype=float), np.asarray(cos_phi, dtype=float), k,
-                    prof.p1, prof.p2, prof.p3, prof.p4, prof.p5)
+    r = _radius_ufunc()(np.asarray(sin_phi, dtype=float), np.asarray(cos_phi, dtype=float), k,
+                        prof.p1, prof.p2, prof.p3, prof.p4, prof.p5)
     if not np.all(np.isfinite(r)):  # pragma: no cover - geometry guarantees a root
         raise FloatingPointError(f"no boundary root for the {prof.name} profile")
     return r
@@ -246,9 +248,20 @@ def _radius(sin_phi, cos_phi, k, p1, p2, p3, p4, p5):
 
 
 radius_scalar = nb.njit(cache=True, nogil=True)(_radius)
-#: `boundary_radius` without validation, as a ufunc (profile parameters broadcast).
-radius_core = nb.vectorize(["float64(float64, float64, float64, float64, float64, float64, float64, float64)"],
-                           cache=True)(_radius)
+
+
+@lru_cache(maxsize=1)
+def _radius_ufunc():
+    """`_radius` as a ufunc, built on first use (building it costs 0.2 s of every start otherwise)."""
+    return nb.vectorize(["float64(float64, float64, float64, float64, float64, float64, float64, float64)"],
+                        cache=True)(_radius)
+
+
+def __getattr__(name):
+    """``radius_core``: `boundary_radius` without validation, as a ufunc (profile parameters broadcast)."""
+    if name == "radius_core":
+        return _radius_ufunc()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def tip_radius(profile: str | NAPProfile) -> float:
@@ -262,4 +275,9 @@ def tip_radius(profile: str | NAPProfile) -> float:
     0.8667
     """
     prof = get_profile(profile)
-    return float(boundary_radius(0.0, 1.0, prof, max(prof.k_min, 1.0)))
+    return _tip_radius(prof.p1, prof.p2, prof.p3, prof.p4, prof.p5, max(prof.k_min, 1.0))
+
+
+@lru_cache(maxsize=16)
+def _tip_radius(p1, p2, p3, p4, p5, k) -> float:
+    return float(radius_scalar(0.0, 1.0, k, p1, p2, p3, p4, p5))  # the same arithmetic as the ufunc

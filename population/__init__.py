@@ -1,17 +1,34 @@
-"""Populations of afferents: specs, sampling, scenes, simulation, datasets."""
+"""Populations of afferents: specs, sampling, scenes, simulation, datasets.
 
-from .arrays import from_array, from_long_csv, save_array
-from .dataset import binned_counts, binned_rates, describe_dataset, load_dataset, psth, save_dataset
-from .plan import make_plan
-from .sampling import Population, make_population, sample_population
-from .scenes import Contact, Scene, Sites, Stage, birznieks, from_csv, press_push_lift, rotating_shear, taxel_radius
-from .simulate import plan_run, simulate
-from .spec import PopulationSpec, load_spec, spec_from_dict
+Names are imported on first use (PEP 562), so ``import population`` costs
+only what a caller touches: no xarray before a dataset is built, no scipy
+before a filter is designed.
+"""
 
-__all__ = [
-    "from_array", "from_long_csv", "save_array",
-    "binned_counts", "binned_rates", "describe_dataset", "load_dataset", "psth", "save_dataset",
-    "make_plan", "Population", "make_population", "sample_population",
-    "Contact", "Scene", "Sites", "Stage", "birznieks", "from_csv", "press_push_lift", "rotating_shear", "taxel_radius",
-    "plan_run", "simulate", "PopulationSpec", "load_spec", "spec_from_dict",
-]
+from importlib import import_module
+
+_WHERE = {
+    "arrays": ("from_array", "from_long_csv", "save_array"),
+    "dataset": ("binned_counts", "binned_rates", "describe_dataset", "load_dataset", "psth", "save_dataset"),
+    "plan": ("make_plan",),
+    "sampling": ("Population", "make_population", "sample_population"),
+    "scenes": ("Contact", "Scene", "Sites", "Stage", "birznieks", "from_csv", "press_push_lift", "rotating_shear",
+               "taxel_radius"),
+    "simulate": ("plan_run", "simulate"),
+    "spec": ("PopulationSpec", "load_spec", "spec_from_dict"),
+}
+_MODULE_OF = {name: module for module, names in _WHERE.items() for name in names}
+
+__all__ = sorted(_MODULE_OF)
+
+
+def __getattr__(name):
+    if name not in _MODULE_OF:
+        raise AttributeError(f"module 'population' has no attribute {name!r}")
+    value = getattr(import_module(f".{_MODULE_OF[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

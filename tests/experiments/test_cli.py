@@ -59,3 +59,15 @@ def test_unwritable_out_is_one_line_error(capsys, tmp_path):
     code, out, err = run(capsys, "reproduce", "table2", "--engine", "direct", "--out", str(blocker / "d"))
     assert code == 2
     assert err.startswith("ddmm: error:") and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_every_help_page_prints(capsys):
+    """``ddmm --help`` and each command's ``--help`` exit 0 (a stray % in a help string once broke the top one)."""
+    from experiments.cli import build_parser, main
+
+    commands = build_parser()._subparsers._group_actions[0].choices
+    for argv in [["--help"]] + [[c, "--help"] for c in commands]:
+        with pytest.raises(SystemExit) as exc:
+            main(argv)
+        assert exc.value.code == 0, argv
+    assert "decode" in capsys.readouterr().out
