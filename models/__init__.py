@@ -4,7 +4,7 @@ Names are imported on first use (PEP 562): ``import models`` loads nothing
 heavy until a name is touched.
 """
 
-from importlib import import_module
+from ._lazy import lazy_exports
 
 _WHERE = {
     "attenuation": ("F_TH", "UNTUNED", "attenuated_force", "attenuation_factor", "shear_magnitude"),
@@ -15,18 +15,4 @@ _WHERE = {
     "neuron": ("NEURON_PARAMS", "NeuronParams", "resting_state"),
     "pipeline": ("compute_currents", "simulate"),
 }
-_MODULE_OF = {name: module for module, names in _WHERE.items() for name in names}
-
-__all__ = sorted(_MODULE_OF)
-
-
-def __getattr__(name):
-    if name not in _MODULE_OF:
-        raise AttributeError(f"module 'models' has no attribute {name!r}")
-    value = getattr(import_module(f".{_MODULE_OF[name]}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

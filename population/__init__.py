@@ -5,7 +5,7 @@ only what a caller touches: no xarray before a dataset is built, no scipy
 before a filter is designed.
 """
 
-from importlib import import_module
+from models._lazy import lazy_exports
 
 _WHERE = {
     "arrays": ("from_array", "from_long_csv", "save_array"),
@@ -17,18 +17,4 @@ _WHERE = {
     "simulate": ("plan_run", "simulate"),
     "spec": ("PopulationSpec", "load_spec", "spec_from_dict"),
 }
-_MODULE_OF = {name: module for module, names in _WHERE.items() for name in names}
-
-__all__ = sorted(_MODULE_OF)
-
-
-def __getattr__(name):
-    if name not in _MODULE_OF:
-        raise AttributeError(f"module 'population' has no attribute {name!r}")
-    value = getattr(import_module(f".{_MODULE_OF[name]}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

@@ -26,3 +26,15 @@ def test_docstring_examples(module_name):
         runner.run(test)
     result = runner.summarize(verbose=False)
     assert result.failed == 0, f"{result.failed} docstring example(s) failed in {module_name}"
+
+
+def test_packages_import_lazily_and_keep_their_names():
+    """``import population`` loads no xarray, scipy.signal or Brian2; ``population.simulate`` stays the function."""
+    import subprocess
+    import sys
+
+    code = ("import sys, population; heavy = [m for m in ('xarray', 'scipy.signal', 'brian2', 'dask') if m in sys.modules];"
+            "import population.simulate; from population import simulate;"
+            "print(heavy, callable(simulate) and simulate.__name__ == 'simulate')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
+    assert out == "[] True"
