@@ -10,7 +10,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .rng import normal
+from .rng import normal_row
 
 __all__ = ["filter_sections", "stage_tail", "receptor_noise_keyed", "stage_kernel", "smooth_kernel", "transduce_inplace"]
 
@@ -98,15 +98,22 @@ def _noisy(d, xi, cv_scale, signed):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def receptor_noise_keyed(x, lo, hi, key, afferent_id, sample, cv_scale, signed):
-    """`stage_tail`'s receptor noise with each draw made on demand (`models.rng.normal`), in place on ``x``.
+def receptor_noise_keyed(x, lo, hi, key, afferent_id, sample, cv_scale, signed, words, xi):
+    """`stage_tail`'s receptor noise with the draws made here (`models.rng.normal_row`), in place on ``x``.
 
-    An undriven afferent (d = 0) keeps d = 0 whatever its draw, so its draw is
-    never made: the same bits as drawing it, at no cost.
+    A group with no driven afferent (every d = 0) keeps d = 0 whatever its
+    draws, so it draws nothing: the same bits as drawing, at no cost.
+    ``words`` and ``xi`` are scratch.
     """
     for j in range(lo, hi):
+        if x[j] != 0.0:
+            break
+    else:
+        return
+    normal_row(key, afferent_id, lo, hi, sample, words, xi)
+    for j in range(lo, hi):
         if x[j] != 0.0 and cv_scale[j] != 0.0:
-            x[j] = _noisy(x[j], normal(key, afferent_id[j], sample), cv_scale[j], signed)
+            x[j] = _noisy(x[j], xi[j], cv_scale[j], signed)
 
 
 @nb.njit(cache=True, nogil=True)
