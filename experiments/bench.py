@@ -39,6 +39,8 @@ CASES = {
 #: workers, and the streaming encoder's per-chunk latency.
 EXTRA_CASES = ("scale_100k_inprocess", "scale_100k_2workers", "stream_fingertip", "stream_hand",
                "hand_5sites_1s_direct", "fingertip_16taxels_1s_direct")
+#: ``--cases scaling``: afferents x simulated seconds, each in a fresh process.
+SCALING = tuple(f"scaling_{n}k_{t}s" for n in (1, 10, 100) for t in (1, 10))
 #: Multi-site cases and the one-site case each is compared with (same population, same run).
 SITE_BASELINES = {"hand_5sites_1s_direct": "hand_1s_direct", "fingertip_16taxels_1s_direct": "fingertip_1s_direct"}
 DT = 1e-4
@@ -193,8 +195,36 @@ def _sites_case(name: str) -> dict:
             "spikes": int(ds.sizes["spike"]), "n_sites": scene.n_sites}
 
 
+def _scaling_case(name: str) -> dict:
+    """``scaling_<n>k_<t>s``: n thousand afferents of the hand's types for t s, direct, whole pipeline."""
+    import dataclasses
+
+    from population import birznieks, load_spec, sample_population, simulate
+    from population.spec import Region
+
+    n_k, seconds = int(name.split("_")[1][:-1]), float(name.split("_")[2][:-1])
+    spec = load_spec("hand")
+    counts = spec.n_afferents()
+    total = sum(counts.values())
+    types = {k: dataclasses.replace(t, count=max(1, round(counts[k] * n_k * 1000 / total))) for k, t in spec.types.items()}
+    pop = sample_population(spec.replace(map=None, region=Region(center_mm=(0.0, -80.0), semi_axes_mm=(45.0, 95.0)),
+                                         types=types), rng=0)
+    scene = birznieks(90.0, hold_s=seconds - 0.25)
+    simulate(pop.select(range(min(len(pop), 2000))), birznieks(90.0), engine="direct", seed=0, quiet=True)  # warm-up
+    start = time.perf_counter()
+    ds = simulate(pop, scene, engine="direct", dt=DT, seed=0, quiet=True)
+    wall = time.perf_counter() - start
+    return {"name": name, "engine": "direct", "n_afferents": len(pop), "sim_s": seconds, "dt_ms": DT * 1e3,
+            "wall_s": round(wall, 4), "afferent_s_per_wall_s": round(len(pop) * seconds / wall, 1),
+            "us_per_afferent_second": round(wall / (len(pop) * seconds) * 1e6, 3),
+            "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
+            "spikes": int(ds.sizes["spike"])}
+
+
 def run_extra(name: str) -> dict:
-    """Run one of `EXTRA_CASES` in this process."""
+    """Run one of `EXTRA_CASES` or `SCALING` in this process."""
+    if name in SCALING:
+        return _scaling_case(name)
     if name in SITE_BASELINES:
         return _sites_case(name)
     if name.startswith("scale_100k"):
@@ -241,8 +271,10 @@ def _cold_main(engine: str, out: str) -> None:
 
 
 def run_bench(cases=None) -> dict:
-    """All cases, each in a fresh process, plus the cold starts."""
+    """All cases, each in a fresh process, plus the cold starts (``cases=["scaling"]``: the scaling table)."""
     names = list(CASES) + list(EXTRA_CASES) if cases is None else list(cases)
+    if names == ["scaling"]:
+        return {"cases": [_subprocess_case(n) for n in SCALING], "ratios": {}, "one_time": {}}
     results = [_subprocess_case(n) for n in names]
     one_time = {}
     for engine in ("direct", "brian2") if cases is None else ():
@@ -272,6 +304,8 @@ def _table(result: dict) -> str:
         if "median_ms" in c:
             notes.append(f"per 1 ms chunk, real-time paced: median {c['median_ms']:.3f} ms, p99 {c['p99_ms']:.3f} ms; "
                          f"back to back: {c['unpaced_median_ms']:.3f} / {c['unpaced_p99_ms']:.3f} ms")
+        if "us_per_afferent_second" in c:
+            notes.append(f"{c['us_per_afferent_second']:.2f} us per afferent-second")
         if "peak_rss_per_worker_mb" in c:
             notes.append(f"{c['workers']} workers, peak {c['peak_rss_per_worker_mb']:.0f} MB per worker")
         lines.append(f"| {c['name']} | {c['engine']} | {c['n_afferents']} | {c['sim_s']:g} | {c['wall_s']:.3f} "
@@ -284,28 +318,43 @@ def register(sub) -> None:
     """Add ``ddmm bench``."""
     p = sub.add_parser("bench", help="speed and memory of the whole pipeline (fresh process per case)")
     p.add_argument("--json", action="store_true")
-    p.add_argument("--cases", default=None, help="comma-separated subset of: " + ", ".join([*CASES, *EXTRA_CASES]))
+    p.add_argument("--out", metavar="DIR", help="write bench.json (and scaling.png for --cases scaling) here")
+    p.add_argument("--cases", default=None, help="'scaling' (afferents x seconds) or a comma-separated subset of: "
+                   + ", ".join([*CASES, *EXTRA_CASES]))
     p.set_defaults(func=_run)
 
 
 def _run(args) -> int:
     cases = None if args.cases is None else [c.strip() for c in args.cases.split(",")]
+    allowed = [*CASES, *EXTRA_CASES, *SCALING]
     for c in cases or []:
-        if c not in CASES and c not in EXTRA_CASES:
-            raise ValueError(f"--cases: {c!r} is unknown; allowed: {', '.join([*CASES, *EXTRA_CASES])}")
+        if c not in allowed and cases != ["scaling"]:
+            raise ValueError(f"--cases: {c!r} is unknown; allowed: scaling, {', '.join(allowed)}")
+    out_dir = None
+    if args.out:
+        from .io import ensure_out_dir
+
+        out_dir = ensure_out_dir(args.out)
     result = run_bench(cases)
     print(json.dumps(result) if args.json else _table(result))
+    if out_dir is not None:
+        from .io import save_figure, save_json
+        from .plotting import plot_scaling
+
+        save_json(result, out_dir / "bench.json")
+        if cases == ["scaling"]:
+            save_figure(plot_scaling(result["cases"]), out_dir / "scaling.png")
     return 0
 
 
 if __name__ == "__main__":  # pragma: no cover - the per-case subprocess entries
     parser = argparse.ArgumentParser()
-    parser.add_argument("--case", choices=sorted([*CASES, *EXTRA_CASES]))
+    parser.add_argument("--case", choices=sorted([*CASES, *EXTRA_CASES, *SCALING]))
     parser.add_argument("--cold", nargs=2, metavar=("ENGINE", "OUT"))
     cli_args = parser.parse_args()
     if cli_args.cold:
         _cold_main(*cli_args.cold)
-    elif cli_args.case in EXTRA_CASES:
+    elif cli_args.case in EXTRA_CASES or cli_args.case in SCALING:
         print(json.dumps(run_extra(cli_args.case)))
     else:
         print(json.dumps(run_case(cli_args.case)))

@@ -267,3 +267,29 @@ def plot_pareto(rows) -> Figure:
     ax.set_title("accuracy against cost (labels: dt in ms)")
     ax.legend(fontsize=7, ncol=2)
     return fig
+
+
+def plot_scaling(cases) -> Figure:
+    """Cost against work from ``ddmm bench --cases scaling``: wall time and us per afferent-second.
+
+    ``cases`` are the bench's case dicts (``n_afferents``, ``sim_s``, ``wall_s``).
+    """
+    fig = Figure(figsize=(9, 3.6))
+    ax, ax2 = fig.subplots(1, 2)
+    for seconds, marker in ((1.0, "o"), (10.0, "s")):
+        rows = sorted((c for c in cases if c["sim_s"] == seconds), key=lambda c: c["n_afferents"])
+        n = np.array([c["n_afferents"] for c in rows], float)
+        wall = np.array([c["wall_s"] for c in rows])
+        ax.loglog(n * seconds, wall, marker=marker, label=f"{seconds:g} s scenes")
+        ax2.semilogx(n * seconds, wall / (n * seconds) * 1e6, marker=marker, label=f"{seconds:g} s scenes")
+    work = np.array([1e3, 1e6])
+    ax.loglog(work, work * 20e-6, "k:", label="linear (20 us per afferent-second)")
+    ax.set_xlabel("afferent-seconds simulated")
+    ax.set_ylabel("wall time (s)")
+    ax2.set_xlabel("afferent-seconds simulated")
+    ax2.set_ylabel("us per afferent-second")
+    ax2.set_ylim(bottom=0)
+    ax.legend(fontsize=8)
+    fig.suptitle("Whole pipeline, direct engine, dt = 0.1 ms (ddmm bench --cases scaling)")
+    fig.tight_layout()
+    return fig

@@ -71,3 +71,13 @@ def test_every_help_page_prints(capsys):
             main(argv)
         assert exc.value.code == 0, argv
     assert "decode" in capsys.readouterr().out
+
+
+def test_plot_scaling_and_bench_case_names():
+    from experiments.plotting import plot_scaling
+
+    fig = plot_scaling([{"n_afferents": 1000, "sim_s": 1.0, "wall_s": 0.04},
+                        {"n_afferents": 10000, "sim_s": 1.0, "wall_s": 0.3},
+                        {"n_afferents": 1000, "sim_s": 10.0, "wall_s": 0.3}])
+    assert len(fig.axes) == 2 and fig.axes[1].get_ylabel() == "us per afferent-second"
+    assert main(["bench", "--cases", "nope"]) == 2
