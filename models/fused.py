@@ -38,7 +38,7 @@ from .nap import get_profile, tip_radius
 from .neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
 from .rng import normal_row
 
-__all__ = ["FusedPlan", "mix_forces"]
+__all__ = ["FusedPlan", "mix_forces", "mixing_matrix"]
 
 # Rows of the per-afferent float table.
 _COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA = range(12)
@@ -51,7 +51,7 @@ _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = ran
 _OFFSET, _Y1, _Y2, _SLOW, _SMOOTH = range(5)
 
 _NO_NORMALS = np.zeros((0, 1)).T  # same layout as a transposed noise block
-_NO_FORCES, _NO_LOCAL = np.zeros((0, 3)), np.zeros((0, 0, 3))
+_NO_FORCES, _NO_LOCAL = np.zeros((0, 3)), np.zeros((0, 3, 0))
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -64,25 +64,11 @@ def _shear(fx, fy, two_fth):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _drive(aff_f, j, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value, f_th, opponent):
-    """Afferent ``j``'s drive in newtons: F_A = AF F_Z, or SA-II's stretch (`stretch_drive`)."""
-    p = 1.0
-    if tuned and mag > 0.0 and (smooth_reading or stretch or mag > f_th):
-        p = profile_value(ux, uy, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j], aff_f[_P1, j], aff_f[_P2, j],
-                          aff_f[_P3, j], aff_f[_P4, j], aff_f[_P5, j], aff_f[_TIP, j])
-    if stretch:
-        return mag * (p - opponent * (1.0 - p))
-    if tuned:
-        af = ((p - 1.0) * w) + 1.0 if smooth_reading else (p if mag > f_th else outside_value)
-        return af * fz
-    return fz
-
-
-@nb.njit(cache=True, nogil=True, inline="always")
 def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value, f_th,
                   opponent):
-    """`_drive` for a group that feels one force, in passes (profile, then the drive): as one loop the
-    profile's branches kept the whole body scalar, 3-4x slower."""
+    """The drive (newtons) of a group that feels one force, in passes: the profile AF where needed
+    (`attenuation.profile_value`), then F_A = AF F_Z under the no-shear reading, or SA-II's stretch
+    (`stretch_drive`).  As one loop, the profile's branches kept the whole body scalar, 3-4x slower."""
     if tuned and mag > 0.0 and (smooth_reading or stretch or mag > f_th):
         for j in range(lo, hi):
             f[j] = profile_value(ux, uy, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j], aff_f[_P1, j], aff_f[_P2, j],
@@ -100,23 +86,67 @@ def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_r
             f[j] = (f[j] if mag > f_th else outside_value) * fz
 
 
-@nb.njit(cache=True, nogil=True)
-def mix_forces(forces, indptr, indices, coeff):
-    """Each afferent's local force, shape (n_samples, n_afferents, 3), from site forces (n_samples, n_sites, 3).
+def mixing_matrix(indptr, indices, coeff, n_sites: int) -> np.ndarray:
+    """The sparse local-force coefficients (`population.spatial.local_mixing`) as a dense (n_sites, n_afferents)."""
+    m = indptr.size - 1
+    out = np.zeros((n_sites, m))
+    rows = np.repeat(np.arange(m), np.diff(indptr))
+    out[indices, rows] = coeff
+    return out
 
-    ``F_i = sum_k coeff[k] F[indices[k]]`` over ``k`` in ``indptr[i]:indptr[i + 1]``
-    (`population.spatial.local_mixing`), summed in that fixed order so any
-    chunking of time gives the same bits.
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_reading, outside_value, f_th, opponent,
+                 mags, wts):
+    """`_shared_drive` for afferents that each feel their own force ``local`` (3, n_afferents), in passes:
+    shear magnitude and weight, the profile where needed, then the drive (the same arithmetic)."""
+    for j in range(lo, hi):
+        mags[j] = math.hypot(local[0, j], local[1, j])
+    for j in range(lo, hi):
+        x = min(max(mags[j] / two_fth, 0.0), 1.0)
+        wts[j] = x * x * (3.0 - 2.0 * x)  # `transition_weight`
+    for j in range(lo, hi):
+        mag = mags[j]
+        p = 1.0
+        if tuned and mag > 0.0 and (smooth_reading or stretch or mag > f_th):
+            p = profile_value(local[0, j] / mag, local[1, j] / mag, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j],
+                              aff_f[_P1, j], aff_f[_P2, j], aff_f[_P3, j], aff_f[_P4, j], aff_f[_P5, j],
+                              aff_f[_TIP, j])
+        f[j] = p
+    if stretch:
+        for j in range(lo, hi):
+            f[j] = mags[j] * (f[j] - opponent * (1.0 - f[j]))
+    elif not tuned:
+        for j in range(lo, hi):
+            f[j] = local[2, j]
+    elif smooth_reading:
+        for j in range(lo, hi):
+            f[j] = (((f[j] - 1.0) * wts[j]) + 1.0) * local[2, j]
+    else:
+        for j in range(lo, hi):
+            f[j] = (f[j] if mags[j] > f_th else outside_value) * local[2, j]
+
+
+@nb.njit(cache=True, nogil=True)
+def mix_forces(forces, weights):
+    """Each afferent's local force, shape (n_samples, 3, n_afferents), from site forces (n_samples, n_sites, 3).
+
+    ``F_a = sum_s weights[s, a] F_s``, summed over sites in increasing order
+    whatever the chunking, so any split of time gives the same bits; the
+    loop over afferents is innermost and vectorises.
     """
-    n, m = forces.shape[0], indptr.size - 1
-    out = np.zeros((n, m, 3))
+    n, n_sites, m = forces.shape[0], weights.shape[0], weights.shape[1]
+    out = np.empty((n, 3, m))
+    acc = np.empty(m)  # a fresh buffer: LLVM knows it aliases nothing, so the loop vectorises
     for i in range(n):
-        for j in range(m):
-            for k in range(indptr[j], indptr[j + 1]):
-                c, s = coeff[k], indices[k]
-                out[i, j, 0] += c * forces[i, s, 0]
-                out[i, j, 1] += c * forces[i, s, 1]
-                out[i, j, 2] += c * forces[i, s, 2]
+        for axis in range(3):
+            acc[:] = 0.0
+            for s in range(n_sites):
+                c = forces[i, s, axis]
+                if c != 0.0:  # adding 0 * w leaves every sum as it is
+                    for j in range(m):
+                        acc[j] += weights[s, j] * c
+            out[i, axis] = acc
     return out
 
 
@@ -126,7 +156,7 @@ def _front(forces, local, is_local, key, noisy_any, ids, sample0, state, started
     """Force to linear drive (n, n_afferents); ``state`` updated in place.
 
     ``forces`` (n, 3) is felt by every afferent, or with ``is_local`` each
-    afferent feels its own ``local`` (n, n_afferents, 3).  Groups (runs of
+    afferent feels its own ``local`` (n, 3, n_afferents).  Groups (runs of
     one type, tuned or not) are the outer loop, so each inner loop over
     afferents has loop-invariant constants and branches.
     """
@@ -134,6 +164,7 @@ def _front(forces, local, is_local, key, noisy_any, ids, sample0, state, started
     z, offset = state[:rows], state[rows + _OFFSET]
     y1, y2, slow = state[rows + _Y1], state[rows + _Y2], state[rows + _SLOW]
     out, f, words, xi = np.empty((n, m)), np.empty(m), np.empty(m, np.uint64), np.empty(m)
+    mags, wts = np.empty(m), np.empty(m)
     gain, cv_scale, two_fth = aff_f[_GAIN], aff_f[_CV], 2.0 * f_th
     for i in range(n):
         fz, mag, ux, uy, w = 0.0, 0.0, 0.0, 0.0, 0.0
@@ -144,10 +175,8 @@ def _front(forces, local, is_local, key, noisy_any, ids, sample0, state, started
             lo, hi = grp_i[_START, g], grp_i[_STOP, g]
             tuned, stretch = grp_i[_TUNED_G, g] != 0, grp_i[_SIGNED, g] != 0
             if is_local:
-                for j in range(lo, hi):
-                    mag, ux, uy, w = _shear(local[i, j, 0], local[i, j, 1], two_fth)
-                    f[j] = _drive(aff_f, j, tuned, stretch, local[i, j, 2], mag, ux, uy, w, smooth_reading,
-                                  outside_value, f_th, opponent)
+                _local_drive(f, lo, hi, local[i], aff_f, tuned, stretch, two_fth, smooth_reading, outside_value,
+                             f_th, opponent, mags, wts)
             elif not tuned and not stretch:
                 f[lo:hi] = fz  # untuned pressure afferents: F_A = F_Z
             else:
@@ -363,7 +392,7 @@ class FusedPlan:
         """Currents (mV/ms), shape (n_samples, n_afferents), of forces in newtons.
 
         ``forces`` is (n_samples, 3), felt by every afferent, or each
-        afferent's own (n_samples, n_afferents, 3) (`mix_forces`).
+        afferent's own (n_samples, 3, n_afferents) (`mix_forces`).
         ``state`` is updated in place; ``started`` is False on the first
         chunk, whose first sample is sample ``sample0`` of the scene.  With
         a stream ``key`` (`models.rng.stream_key`), the noise of sample n of

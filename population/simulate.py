@@ -21,7 +21,7 @@ from models._validation import check_choice, check_positive
 from models.attenuation import F_TH, NO_SHEAR_READINGS
 from models.currents import check_fs
 from models.engines import ENGINES, METHODS, prepare, substeps_for
-from models.fused import FusedPlan, mix_forces
+from models.fused import FusedPlan, mix_forces, mixing_matrix
 
 from .noise import noise_key, root_seed
 from .plan import RECORD_CHOICES, make_plan
@@ -105,15 +105,18 @@ def block_plan(population, scene, scale, no_shear: str):
     theta = pop.theta_t if scene.sites is None else frame_theta(pop)
     plan = FusedPlan(pop.afferent_type, pop.nap, theta, pop.k, scale, pop.noise_cv, pop.noise_sigma, pop.current,
                      scene.fs, no_shear, F_TH, pop.afferent_id)
-    mixing = None if scene.sites is None else local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, scene.sites)[:3]
+    mixing = None
+    if scene.sites is not None:
+        indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, scene.sites)
+        mixing = mixing_matrix(indptr, indices, coeff, len(scene.sites))
     return plan, mixing
 
 
 def chunk_forces(scene, sl: slice, mixing) -> np.ndarray:
-    """Forces of samples ``sl``: (n, 3) felt by all, or each afferent's own (n, n_afferents, 3)."""
+    """Forces of samples ``sl``: (n, 3) felt by all, or each afferent's own (n, 3, n_afferents)."""
     if mixing is None:
         return np.column_stack([scene.fx[sl], scene.fy[sl], scene.fz[sl]])
-    return mix_forces(scene.site_forces[sl], *mixing)
+    return mix_forces(scene.site_forces[sl], mixing)
 
 
 def _run_trial(job: ChunkJob, trial: int, config: SimConfig, progress=None):

@@ -172,7 +172,7 @@ class Encoder:
             return StreamSpikes(np.empty(0, np.int64), np.empty(0))
         state = self._state.copy()  # committed only if the whole chunk succeeds
         if self._mixing is not None:
-            forces = mix_forces(forces, *self._mixing)  # each afferent's own force, (n, n_afferents, 3)
+            forces = mix_forces(forces, self._mixing)  # each afferent's own force, (n, 3, n_afferents)
         afferent, step, neuron = self._plan.advance(forces, state, self._samples, self._key, self._neuron, dt=self.dt,
                                                     method=self.method, engine=self.engine)
         step0 = self._samples * self.substeps

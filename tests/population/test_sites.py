@@ -64,9 +64,9 @@ def test_local_mixing_is_a_weighted_mean_of_tractions():
 def test_afferents_either_side_of_a_twist_feel_opposite_shear(pop):
     sc = twist()
     indptr, indices, coeff, cover = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, sc.sites)
-    from models.fused import mix_forces
+    from models.fused import mix_forces, mixing_matrix
 
-    local = mix_forces(sc.site_forces[200:201], indptr, indices, coeff)[0]
+    local = mix_forces(sc.site_forces[200:201], mixing_matrix(indptr, indices, coeff, 2))[0].T
     sai = (pop.afferent_type == "SAI") & (cover > 0)
     left, right = sai & (pop.x_mm < -4), sai & (pop.x_mm > 4)
     assert left.any() and right.any()
