@@ -229,9 +229,13 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f
 
 @nb.njit(cache=True, nogil=True)
 def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i, sigma_idx,
-                        substeps, method, h,
-                        half, a, b, c, d, v, u, v_peak, v_floor, block):
-    """`_back`, then the direct engine on the current; returns spikes, the smallest current and finiteness."""
+                        substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block):
+    """`_back`, then the direct engine on the current.
+
+    Returns spikes, the smallest current, whether the state stayed finite and
+    whether a neuron spiked on consecutive steps (the one-spike-per-step cap
+    bound): the seam's checks need the full spike lists only then.
+    """
     lowest = _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i, sigma_idx)
     idx, stp = _integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, 0,
                                 v.size)
@@ -239,7 +243,12 @@ def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f
     for j in range(v.size):
         if not (math.isfinite(v[j]) and math.isfinite(u[j])):
             finite = False
-    return idx, stp, lowest, finite
+    last, capped = np.full(v.size, -2, np.int64), False
+    for k in range(idx.size):  # spikes come neuron block by block, in time within a block
+        if stp[k] == last[idx[k]] + 1:
+            capped = True
+        last[idx[k]] = stp[k]
+    return idx, stp, lowest, finite, capped
 
 
 class FusedPlan:
@@ -357,10 +366,11 @@ class FusedPlan:
             v, u = (np.array(x, dtype=float) for x in resting_state(args[5]))
         else:
             v, u = neuron.v.copy(), neuron.u.copy()
-        current, afferent, step, lowest, finite = self.spikes(forces, state, started, sample0, key, args, v, u)
+        current, afferent, step, lowest, finite, capped = self.spikes(forces, state, started, sample0, key, args, v,
+                                                                     u)
         if method != "euler":
             check_stability(np.array([lowest]), dt, method)
-        if not finite or afferent.size > 1:
+        if not finite or capped:
             check_integration(afferent, step, v, u, current, method, dt)
         return afferent, step, NeuronState(v, u)
 
@@ -404,7 +414,7 @@ class FusedPlan:
         return current
 
     def spikes(self, forces, state, started, sample0, key, neuron, v, u):
-        """Currents, then the direct engine: (current, afferent, step, smallest current, finite) of the chunk.
+        """Currents, then the direct engine: (current, afferent, step, smallest current, finite, capped).
 
         Arguments as `currents`; ``neuron`` is (substeps, method code, h,
         half, a, b, c, d, v_peak, v_floor, block) as `models.direct` takes

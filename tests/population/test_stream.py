@@ -89,3 +89,22 @@ def test_cli_stream(capsys, monkeypatch):
     rows = [r.split(",") for r in out.strip().splitlines()]
     assert len(rows) > 50 and {r[2] for r in rows} <= {"SAI", "RAI", "RAII", "SAII"}
     assert "line 302 skipped" in err and "line 303 skipped" in err
+
+
+def test_the_spike_cap_warning_survives_the_fused_path():
+    """A drive far past the step rate warns offline and when streamed (the fused kernel flags it)."""
+    import warnings
+
+    from models.engines import SpikeCapWarning
+    from population import birznieks, make_population
+
+    pop = make_population(["SAI"] * 3, gain=1e4)
+    scene = birznieks(90.0)
+    with pytest.warns(SpikeCapWarning, match="consecutive steps"):
+        simulate(pop, scene, engine="direct", quiet=True)
+    enc = Encoder(pop, scene.fs, seed=0)
+    with pytest.warns(SpikeCapWarning):
+        enc.push(np.column_stack([scene.fx, scene.fy, scene.fz])[:200])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SpikeCapWarning)
+        Encoder(make_population(["SAI"]), scene.fs, seed=0).push(np.column_stack([scene.fx, scene.fy, scene.fz]))
