@@ -63,10 +63,27 @@ def run_case(name: str) -> dict:
     start = time.perf_counter()
     n, ds = _pipeline(population, engine, sim_s)
     wall = time.perf_counter() - start
-    return {"name": name, "engine": engine, "n_afferents": n, "sim_s": sim_s, "dt_ms": DT * 1e3,
-            "wall_s": round(wall, 4), "afferent_s_per_wall_s": round(n * sim_s / wall, 1),
-            "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
-            "spikes": int(ds.sizes["spike"])}
+    result = {"name": name, "engine": engine, "n_afferents": n, "sim_s": sim_s, "dt_ms": DT * 1e3,
+              "wall_s": round(wall, 4), "afferent_s_per_wall_s": round(n * sim_s / wall, 1),
+              "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
+              "spikes": int(ds.sizes["spike"])}
+    if name == "hand_1s_direct":
+        result["kernel_s"] = _kernel_alone(n, sim_s)
+    return result
+
+
+def _kernel_alone(n: int, sim_s: float) -> float:
+    """The direct engine's integration alone (all threads) on a constant 5 mV/ms for n neurons x sim_s, in s."""
+    import numpy as np
+
+    from models.engines import integrate
+
+    current = np.full((int(sim_s * 1000), n), 5.0)
+    types = np.array(["RAI"] * n)
+    integrate(current[:10], fs=1000.0, dt=DT, afferent_type=types, engine="direct")  # warm-up
+    start = time.perf_counter()
+    integrate(current, fs=1000.0, dt=DT, afferent_type=types, engine="direct")
+    return round(time.perf_counter() - start, 4)
 
 
 def _population_100k():
@@ -285,6 +302,9 @@ def run_bench(cases=None) -> dict:
     ratios = {}
     if "hand_1s_direct" in by and "hand_1s_brian2" in by:
         ratios["brian2_over_direct_hand_1s"] = round(by["hand_1s_brian2"]["wall_s"] / by["hand_1s_direct"]["wall_s"], 2)
+    if "kernel_s" in by.get("hand_1s_direct", {}):
+        ratios["hand_1s_direct_over_integration_kernel"] = round(by["hand_1s_direct"]["wall_s"]
+                                                                 / by["hand_1s_direct"]["kernel_s"], 2)
     if "hand_1s_direct" in by:
         ratios["touchsim_hand_over_direct"] = round(TOUCHSIM_SPEED["hand_wall_s"] / by["hand_1s_direct"]["wall_s"], 2)
     for case, base in SITE_BASELINES.items():
