@@ -51,7 +51,7 @@ _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = ran
 _OFFSET, _Y1, _Y2, _SLOW, _SMOOTH = range(5)
 
 _NO_NORMALS = np.zeros((0, 1)).T  # same layout as a transposed noise block
-_NO_FORCES, _NO_LOCAL = np.zeros((0, 3)), np.zeros((0, 3, 0))
+_NO_FORCES, _NO_SITES, _NO_WEIGHTS = np.zeros((0, 3)), np.zeros((0, 0, 3)), np.zeros((0, 0))
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -127,55 +127,65 @@ def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_readin
             f[j] = (f[j] if mags[j] > f_th else outside_value) * local[2, j]
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def _mix_sample(forces_i, weights, out):
+    """``out[axis, a] = sum_s weights[s, a] forces_i[s, axis]``, over sites in increasing order."""
+    for axis in range(3):
+        row = out[axis]
+        row[:] = 0.0
+        for s in range(weights.shape[0]):
+            c = forces_i[s, axis]
+            if c != 0.0:  # adding 0 * w leaves every sum as it is
+                for j in range(weights.shape[1]):
+                    row[j] += weights[s, j] * c
+
+
 @nb.njit(cache=True, nogil=True)
 def mix_forces(forces, weights):
     """Each afferent's local force, shape (n_samples, 3, n_afferents), from site forces (n_samples, n_sites, 3).
 
     ``F_a = sum_s weights[s, a] F_s``, summed over sites in increasing order
-    whatever the chunking, so any split of time gives the same bits; the
-    loop over afferents is innermost and vectorises.
+    whatever the chunking, so any split of time gives the same bits (the
+    fused kernel mixes sample by sample with the same code).
     """
-    n, n_sites, m = forces.shape[0], weights.shape[0], weights.shape[1]
-    out = np.empty((n, 3, m))
-    acc = np.empty(m)  # a fresh buffer: LLVM knows it aliases nothing, so the loop vectorises
-    for i in range(n):
-        for axis in range(3):
-            acc[:] = 0.0
-            for s in range(n_sites):
-                c = forces[i, s, axis]
-                if c != 0.0:  # adding 0 * w leaves every sum as it is
-                    for j in range(m):
-                        acc[j] += weights[s, j] * c
-            out[i, axis] = acc
+    out = np.empty((forces.shape[0], 3, weights.shape[1]))
+    local = np.empty((3, weights.shape[1]))
+    for i in range(forces.shape[0]):
+        _mix_sample(forces[i], weights, local)
+        out[i] = local
     return out
 
 
 @nb.njit(cache=True, nogil=True)
-def _front(forces, local, is_local, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f, grp_i, sos, fs,
+def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f, grp_i,
+           sos, fs,
            smooth_reading, outside_value, f_th, opponent):
     """Force to linear drive (n, n_afferents); ``state`` updated in place.
 
-    ``forces`` (n, 3) is felt by every afferent, or with ``is_local`` each
-    afferent feels its own ``local`` (n, 3, n_afferents).  Groups (runs of
+    ``forces`` (n, 3) is felt by every afferent, or with ``mixed`` each
+    afferent feels its own mix (``weights``, (n_sites, n_afferents)) of the
+    site forces ``sites`` (n, n_sites, 3), mixed here sample by sample.  Groups (runs of
     one type, tuned or not) are the outer loop, so each inner loop over
     afferents has loop-invariant constants and branches.
     """
-    n, m, rows = forces.shape[0] if not is_local else local.shape[0], aff_i.shape[1], 2 * sos.shape[1]
+    n, m, rows = forces.shape[0] if not mixed else sites.shape[0], aff_i.shape[1], 2 * sos.shape[1]
     z, offset = state[:rows], state[rows + _OFFSET]
     y1, y2, slow = state[rows + _Y1], state[rows + _Y2], state[rows + _SLOW]
     out, f, words, xi = np.empty((n, m)), np.empty(m), np.empty(m, np.uint64), np.empty(m)
-    mags, wts = np.empty(m), np.empty(m)
+    mags, wts, local = np.empty(m), np.empty(m), np.empty((3, m))
     gain, cv_scale, two_fth = aff_f[_GAIN], aff_f[_CV], 2.0 * f_th
     for i in range(n):
         fz, mag, ux, uy, w = 0.0, 0.0, 0.0, 0.0, 0.0
-        if not is_local:
+        if mixed:
+            _mix_sample(sites[i], weights, local)
+        else:
             fz = forces[i, 2]
             mag, ux, uy, w = _shear(forces[i, 0], forces[i, 1], two_fth)
         for g in range(grp_i.shape[1]):
             lo, hi = grp_i[_START, g], grp_i[_STOP, g]
             tuned, stretch = grp_i[_TUNED_G, g] != 0, grp_i[_SIGNED, g] != 0
-            if is_local:
-                _local_drive(f, lo, hi, local[i], aff_f, tuned, stretch, two_fth, smooth_reading, outside_value,
+            if mixed:
+                _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_reading, outside_value,
                              f_th, opponent, mags, wts)
             elif not tuned and not stretch:
                 f[lo:hi] = fz  # untuned pressure afferents: F_A = F_Z
@@ -277,6 +287,9 @@ class FusedPlan:
         Shear threshold in newtons.
     afferent_id : array_like of int, optional
         Stable ids keying each afferent's noise (default 0..n-1).
+    mixing : ndarray, shape (n_sites, n_afferents), optional
+        Each afferent's coefficients of the site forces (`mixing_matrix`):
+        the plan then takes site forces and mixes them in its kernel.
 
     Examples
     --------
@@ -287,9 +300,10 @@ class FusedPlan:
     """
 
     def __init__(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, params, fs, no_shear, f_th,
-                 afferent_id=None):
+                 afferent_id=None, mixing=None):
         afferent_type, nap = np.asarray(afferent_type), np.asarray(nap)
         self.afferent_type, self._neuron_cache = afferent_type, {}
+        self.mixing = None if mixing is None else np.ascontiguousarray(mixing, dtype=float)
         self.afferent_id = np.ascontiguousarray(np.arange(afferent_type.size) if afferent_id is None else afferent_id,
                                                 dtype=np.int64)
         self.n_afferents, self.fs, self.f_th = afferent_type.size, float(fs), float(f_th)
@@ -389,11 +403,14 @@ class FusedPlan:
         return np.zeros((self.rows + 5, self.n_afferents))
 
     def _drive(self, forces, state, started, sample0, key):
-        noisy, is_local = key is not None, forces.ndim == 3
-        drive = _front(_NO_FORCES if is_local else forces, forces if is_local else _NO_LOCAL, is_local,
-                       np.uint64(key or 0), noisy, self.afferent_id, int(sample0), state, started, self.aff_f,
-                       self.aff_i, self.grp_f, self.grp_i, self.sos, self.fs, self.smooth_reading,
-                       self.outside_value, self.f_th, self.opponent)
+        noisy, mixed = key is not None, self.mixing is not None
+        if forces.ndim != (3 if mixed else 2):
+            raise ValueError(f"forces must be {'(n, n_sites, 3) site forces' if mixed else '(n, 3)'} for this plan, "
+                             f"got shape {forces.shape}")
+        drive = _front(_NO_FORCES if mixed else forces, forces if mixed else _NO_SITES,
+                       self.mixing if mixed else _NO_WEIGHTS, mixed, np.uint64(key or 0), noisy, self.afferent_id,
+                       int(sample0), state, started, self.aff_f, self.aff_i, self.grp_f, self.grp_i, self.sos,
+                       self.fs, self.smooth_reading, self.outside_value, self.f_th, self.opponent)
         for cols, stage in self.transducers:
             transduce_inplace(drive[:, cols], stage)
         return drive
@@ -401,8 +418,8 @@ class FusedPlan:
     def currents(self, forces, state, started, sample0=0, key=None):
         """Currents (mV/ms), shape (n_samples, n_afferents), of forces in newtons.
 
-        ``forces`` is (n_samples, 3), felt by every afferent, or each
-        afferent's own (n_samples, 3, n_afferents) (`mix_forces`).
+        ``forces`` is (n_samples, 3), felt by every afferent, or for a plan
+        with a ``mixing`` the site forces (n_samples, n_sites, 3).
         ``state`` is updated in place; ``started`` is False on the first
         chunk, whose first sample is sample ``sample0`` of the scene.  With
         a stream ``key`` (`models.rng.stream_key`), the noise of sample n of

@@ -21,7 +21,7 @@ from models._validation import check_choice, check_positive
 from models.attenuation import F_TH, NO_SHEAR_READINGS
 from models.currents import check_fs
 from models.engines import ENGINES, METHODS, prepare, substeps_for
-from models.fused import FusedPlan, mix_forces, mixing_matrix
+from models.fused import FusedPlan, mixing_matrix
 
 from .noise import noise_key, root_seed
 from .plan import RECORD_CHOICES, make_plan
@@ -96,39 +96,38 @@ class ChunkJob:
 
 
 def block_plan(population, scene, scale, no_shear: str):
-    """The fused plan of a block of afferents (grouped by type) on a scene, and its site mixing (or None).
+    """The fused plan of a block of afferents (grouped by type) on a scene, with its site mixing.
 
     A multi-site scene's forces are in the population's frame, so its AF
     uses ``theta_T + frame_deg`` (`spatial.frame_theta`).
     """
     pop = population
-    theta = pop.theta_t if scene.sites is None else frame_theta(pop)
-    plan = FusedPlan(pop.afferent_type, pop.nap, theta, pop.k, scale, pop.noise_cv, pop.noise_sigma, pop.current,
-                     scene.fs, no_shear, F_TH, pop.afferent_id)
-    mixing = None
+    theta, mixing = pop.theta_t, None
     if scene.sites is not None:
+        theta = frame_theta(pop)
         indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, scene.sites)
         mixing = mixing_matrix(indptr, indices, coeff, len(scene.sites))
-    return plan, mixing
+    return FusedPlan(pop.afferent_type, pop.nap, theta, pop.k, scale, pop.noise_cv, pop.noise_sigma, pop.current,
+                     scene.fs, no_shear, F_TH, pop.afferent_id, mixing)
 
 
-def chunk_forces(scene, sl: slice, mixing) -> np.ndarray:
-    """Forces of samples ``sl``: (n, 3) felt by all, or each afferent's own (n, 3, n_afferents)."""
-    if mixing is None:
+def chunk_forces(scene, sl: slice) -> np.ndarray:
+    """Forces of samples ``sl``: (n, 3) felt by all, or a multi-site scene's (n, n_sites, 3)."""
+    if scene.sites is None:
         return np.column_stack([scene.fx[sl], scene.fy[sl], scene.fz[sl]])
-    return mix_forces(scene.site_forces[sl], mixing)
+    return scene.site_forces[sl]
 
 
 def _run_trial(job: ChunkJob, trial: int, config: SimConfig, progress=None):
     pop, scene = job.population, job.scene
     scale = pop.gain if job.weights is None else pop.gain * job.weights
-    plan, mixing = block_plan(pop, scene, scale, config.no_shear)
+    plan = block_plan(pop, scene, scale, config.no_shear)
     key = noise_key(config.seed, job.condition, trial) if job.noisy else None
     substeps = substeps_for(scene.fs, config.dt)
     state, neuron, afferents, steps = plan.new_state(), None, [], []
     for start in range(0, scene.n_samples, config.time_chunk):
         sl = slice(start, min(scene.n_samples, start + config.time_chunk))
-        afferent, step, neuron = plan.advance(chunk_forces(scene, sl, mixing), state, start, key, neuron,
+        afferent, step, neuron = plan.advance(chunk_forces(scene, sl), state, start, key, neuron,
                                               dt=config.dt, method=config.method, engine=config.engine)
         afferents.append(afferent)
         steps.append(step + start * substeps)
@@ -153,8 +152,8 @@ def population_currents(population, scene, *, no_shear: str = "smooth") -> np.nd
         weights = site_coverage(population, scene.sites)
     scale = population.gain if weights is None else population.gain * weights
     order = _grouped(population, np.arange(len(population)), np.arange(len(population)))
-    plan, mixing = block_plan(population.select(order), scene, scale[order], no_shear)
-    current = plan.currents(chunk_forces(scene, slice(None), mixing), plan.new_state(), False)
+    plan = block_plan(population.select(order), scene, scale[order], no_shear)
+    current = plan.currents(chunk_forces(scene, slice(None)), plan.new_state(), False)
     out = np.empty_like(current)
     out[:, order] = current
     return out

@@ -20,7 +20,6 @@ from models._validation import as_finite_array, check_choice, check_positive
 from models.attenuation import NO_SHEAR_READINGS
 from models.currents import check_fs
 from models.engines import ENGINES, METHODS, prepare, substeps_for
-from models.fused import mix_forces
 
 from .noise import noise_key, root_seed
 from .sampling import Population
@@ -106,7 +105,7 @@ class Encoder:
         self.reset()
 
     def _precompute(self) -> None:
-        """The fused plan (the one `simulate` builds for these afferents) and the site mixing."""
+        """The fused plan (the one `simulate` builds for these afferents, with its site mixing)."""
         pop = self._pop
         scale = pop.gain
         if self.contact is not None:
@@ -114,7 +113,7 @@ class Encoder:
         elif self.sites is not None:
             scale = pop.gain * site_coverage(pop, self.sites)
         frame = _SitesOnly(self.fs, self.sites)
-        self._plan, self._mixing = block_plan(pop, frame, scale, self.no_shear)
+        self._plan = block_plan(pop, frame, scale, self.no_shear)
         noisy = np.any(pop.noise_sigma > 0) or np.any(pop.noise_cv > 0)
         self._key = noise_key(self.seed, 0, 0) if noisy else None
 
@@ -171,8 +170,6 @@ class Encoder:
         if n == 0:
             return StreamSpikes(np.empty(0, np.int64), np.empty(0))
         state = self._state.copy()  # committed only if the whole chunk succeeds
-        if self._mixing is not None:
-            forces = mix_forces(forces, self._mixing)  # each afferent's own force, (n, 3, n_afferents)
         afferent, step, neuron = self._plan.advance(forces, state, self._samples, self._key, self._neuron, dt=self.dt,
                                                     method=self.method, engine=self.engine)
         step0 = self._samples * self.substeps
