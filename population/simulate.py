@@ -77,10 +77,6 @@ class ChunkJob:
         Trials to run; deterministic blocks run trial 0 only.
     noisy : bool
         Whether to add current noise.
-    af_stage : bool
-        Compute AF (else tuned afferents use ``af_constant``).
-    af_constant : float
-        AF when the stage is skipped.
     weights : ndarray or None
         Receptive-field weights of the block's afferents.
     """
@@ -90,25 +86,24 @@ class ChunkJob:
     condition: int
     trials: tuple
     noisy: bool
-    af_stage: bool
-    af_constant: float
     weights: np.ndarray | None
 
 
-def block_plan(population, scene, scale, no_shear: str):
-    """The fused plan of a block of afferents (grouped by type) on a scene, with its site mixing.
+def block_plan(population, fs: float, sites, scale, no_shear: str):
+    """The fused plan of a block of afferents (grouped by type) at sample rate ``fs`` (Hz), with the
+    mixing of ``sites`` (a multi-site scene's `Sites`, or None).
 
     A multi-site scene's forces are in the population's frame, so its AF
     uses ``theta_T + frame_deg`` (`spatial.frame_theta`).
     """
     pop = population
     theta, mixing = pop.theta_t, None
-    if scene.sites is not None:
+    if sites is not None:
         theta = frame_theta(pop)
-        indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, scene.sites)
-        mixing = mixing_matrix(indptr, indices, coeff, len(scene.sites))
+        indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, sites)
+        mixing = mixing_matrix(indptr, indices, coeff, len(sites))
     return FusedPlan(pop.afferent_type, pop.nap, theta, pop.k, scale, pop.noise_cv, pop.noise_sigma, pop.current,
-                     scene.fs, no_shear, F_TH, pop.afferent_id, mixing)
+                     fs, no_shear, F_TH, pop.afferent_id, mixing)
 
 
 def chunk_forces(scene, sl: slice) -> np.ndarray:
@@ -121,7 +116,7 @@ def chunk_forces(scene, sl: slice) -> np.ndarray:
 def _run_trial(job: ChunkJob, trial: int, config: SimConfig, progress=None):
     pop, scene = job.population, job.scene
     scale = pop.gain if job.weights is None else pop.gain * job.weights
-    plan = block_plan(pop, scene, scale, config.no_shear)
+    plan = block_plan(pop, scene.fs, scene.sites, scale, config.no_shear)
     key = noise_key(config.seed, job.condition, trial) if job.noisy else None
     substeps = substeps_for(scene.fs, config.dt)
     state, neuron, afferents, steps = plan.new_state(), None, [], []
@@ -152,7 +147,7 @@ def population_currents(population, scene, *, no_shear: str = "smooth") -> np.nd
         weights = site_coverage(population, scene.sites)
     scale = population.gain if weights is None else population.gain * weights
     order = _grouped(population, np.arange(len(population)), np.arange(len(population)))
-    plan = block_plan(population.select(order), scene, scale[order], no_shear)
+    plan = block_plan(population.select(order), scene.fs, scene.sites, scale[order], no_shear)
     current = plan.currents(chunk_forces(scene, slice(None)), plan.new_state(), False)
     out = np.empty_like(current)
     out[:, order] = current
@@ -244,8 +239,7 @@ def _jobs(population, scenes, the_plan):
             for block in _equal_blocks(positions, the_plan.chunk_size):
                 weights = None if cond.weights is None else cond.weights[block]
                 trials = (0,) if deterministic else tuple(range(the_plan.trials))
-                job = ChunkJob(scene, population.select(sel[block]), c, trials, not deterministic,
-                               cond.af_stage, cond.af_constant, weights)
+                job = ChunkJob(scene, population.select(sel[block]), c, trials, not deterministic, weights)
                 yield c, job, block, deterministic
 
 

@@ -112,8 +112,7 @@ class Encoder:
             scale = pop.gain * receptive_field_weight(pop.x_mm, pop.y_mm, pop.afferent_type, self.contact)
         elif self.sites is not None:
             scale = pop.gain * site_coverage(pop, self.sites)
-        frame = _SitesOnly(self.fs, self.sites)
-        self._plan = block_plan(pop, frame, scale, self.no_shear)
+        self._plan = block_plan(pop, self.fs, self.sites, scale, self.no_shear)
         noisy = np.any(pop.noise_sigma > 0) or np.any(pop.noise_cv > 0)
         self._key = noise_key(self.seed, 0, 0) if noisy else None
 
@@ -182,10 +181,3 @@ class Encoder:
             order = np.lexsort((afferent, step))
             afferent, step = afferent[order], step[order]
         return StreamSpikes(afferent, step * self.dt)
-
-
-class _SitesOnly:
-    """What `block_plan` reads of a scene, for an encoder: its sample rate and sites."""
-
-    def __init__(self, fs, sites):
-        self.fs, self.sites = fs, sites
