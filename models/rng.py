@@ -9,7 +9,7 @@ sample of any afferent can be drawn alone, in any order, by any process:
 chunking, streaming and workers cannot change a value, and a sample nobody
 needs is never drawn.
 
-`normal` turns the 128 bits into a standard normal by a 256-layer ziggurat
+`normal_row` turns the 128 bits into a standard normal by a 256-layer ziggurat
 (Marsaglia & Tsang 2000): 64 bits pick the layer, the sign and a 52-bit
 uniform; the fast path (about 99% of draws) needs one multiply and one
 compare; the rest use the other 64 bits, then further Philox blocks
@@ -92,32 +92,13 @@ def _slow_normal(k0, k1, c0, c1, c2, first_word, x, f, r):
 
 
 @nb.njit(cache=True, nogil=True)
-def normal(key, afferent_id, sample):
-    """The standard normal of (stream ``key``, ``afferent_id``, ``sample``): a pure function.
-
-    ``key`` is a uint64 (`stream_key`), ``afferent_id`` and ``sample``
-    non-negative integers.
-    """
-    k0, k1 = np.uint64(key) & _MASK32, np.uint64(key) >> np.uint64(32)
-    aid = np.uint64(afferent_id)
-    c0, c1, c2 = np.uint64(sample) & _MASK32, aid & _MASK32, aid >> np.uint64(32)
-    a, b, _, _ = philox4x32(c0, c1, c2, np.uint64(0), k0, k1)
-    word = (a << np.uint64(32)) | b
-    i = int(word & np.uint64(0xFF))
-    z = _uniform52(word) * _X[i]
-    if z < _X[i + 1]:
-        return -z if (word >> np.uint64(8)) & np.uint64(1) else z
-    return _slow_normal(k0, k1, c0, c1, c2, word, _X, _F, _R)
-
-
-@nb.njit(cache=True, nogil=True)
 def normal_row(key, afferent_id, lo, hi, sample, words, out):
-    """``out[j] = normal(key, afferent_id[j], sample)`` for ``j`` in ``lo..hi``, in three passes.
+    """``out[j]``: the standard normal of (``key``, ``afferent_id[j]``, ``sample``) for ``j`` in ``lo..hi``.
 
-    The Philox words, then the ziggurat's fast path, then the rare rest: the
-    first two loops have no branches that depend on data, so they vectorise
-    (about 2.5 ns a draw against 13 ns one at a time), and the values are
-    `normal`'s, bit for bit.  ``words`` (uint64) is scratch of the same length.
+    The one implementation of the draw, in three passes: the Philox words,
+    then the ziggurat's fast path, then the rare rest.  The first two loops
+    have no branches that depend on data, so they vectorise (about 2.5 ns a
+    draw against 13 ns one at a time).  ``words`` (uint64) is scratch.
     """
     k0, k1 = np.uint64(key) & _MASK32, np.uint64(key) >> np.uint64(32)
     c0 = np.uint64(sample) & _MASK32
@@ -134,6 +115,20 @@ def normal_row(key, afferent_id, lo, hi, sample, words, out):
         if abs(out[j]) >= _X[(word & np.uint64(0xFF)) + np.uint64(1)]:
             aid = np.uint64(afferent_id[j])
             out[j] = _slow_normal(k0, k1, c0, aid & _MASK32, aid >> np.uint64(32), word, _X, _F, _R)
+
+
+def normal(key: int, afferent_id: int, sample: int) -> float:
+    """The standard normal of (stream ``key``, ``afferent_id``, ``sample``): a pure function.
+
+    Examples
+    --------
+    >>> k = stream_key(1, 0, 0)
+    >>> normal(k, 6, 2) == float(normals(k, [5, 6], 0, 4)[1, 2])
+    True
+    """
+    out = np.empty(1)
+    normal_row(np.uint64(key), np.array([afferent_id], np.int64), 0, 1, int(sample), np.empty(1, np.uint64), out)
+    return float(out[0])
 
 
 @nb.njit(cache=True, nogil=True)

@@ -25,10 +25,7 @@ import numpy as np
 
 from models.rng import normals, stream_key
 
-__all__ = ["MAX_AFFERENT_ID", "noise_key", "draw_noise", "noise_current", "root_seed"]
-
-#: Afferent ids fill two 32-bit counter words.
-MAX_AFFERENT_ID = 1 << 63
+__all__ = ["noise_key", "draw_noise", "noise_current", "root_seed"]
 
 
 def root_seed(seed) -> int:

@@ -113,10 +113,8 @@ def chunk_forces(scene, sl: slice) -> np.ndarray:
     return scene.site_forces[sl]
 
 
-def _run_trial(job: ChunkJob, trial: int, config: SimConfig, progress=None):
+def _run_trial(job: ChunkJob, plan, trial: int, config: SimConfig, progress=None):
     pop, scene = job.population, job.scene
-    scale = pop.gain if job.weights is None else pop.gain * job.weights
-    plan = block_plan(pop, scene.fs, scene.sites, scale, config.no_shear)
     key = noise_key(config.seed, job.condition, trial) if job.noisy else None
     substeps = substeps_for(scene.fs, config.dt)
     state, neuron, afferents, steps = plan.new_state(), None, [], []
@@ -156,9 +154,12 @@ def population_currents(population, scene, *, no_shear: str = "smooth") -> np.nd
 
 def run_chunk(job: ChunkJob, config: SimConfig, progress=None):
     """Simulate one block; returns (trial, afferent index within the block, step) arrays."""
+    pop, scene = job.population, job.scene
+    scale = pop.gain if job.weights is None else pop.gain * job.weights
+    plan = block_plan(pop, scene.fs, scene.sites, scale, config.no_shear)  # once for every trial
     trials, afferents, steps = [], [], []
     for trial in job.trials:
-        aff, stp = _run_trial(job, trial, config, progress)
+        aff, stp = _run_trial(job, plan, trial, config, progress)
         trials.append(np.full(aff.size, trial, np.int64))
         afferents.append(aff)
         steps.append(stp)
