@@ -256,13 +256,17 @@ def _subprocess_case(name: str) -> dict:
 
 
 def _cold_start(engine: str) -> tuple[dict, float]:
-    from population import load_spec
-
     """Time a fresh ``ddmm simulate`` process; first run once to fill caches.
 
     The process runs the CLI and then prints its own peak RSS; the wall time,
-    measured here, includes interpreter start-up and imports.
+    measured here, includes interpreter start-up and imports.  Whether the
+    optional Dask extra is installed is recorded: xarray then imports dask
+    and distributed to probe arrays, about 0.3 s of every start.
     """
+    import importlib.util
+
+    from population import load_spec
+
     with tempfile.TemporaryDirectory() as tmp:
         cmd = [sys.executable, "-m", "experiments.bench", "--cold", engine, os.path.join(tmp, "cold.nc")]
         walls, rss = [], 0.0
@@ -274,7 +278,8 @@ def _cold_start(engine: str) -> tuple[dict, float]:
     n = sum(load_spec("fingertip").n_afferents().values())
     case = {"name": f"cold_start_{engine}", "engine": engine, "n_afferents": n, "sim_s": 0.5,
             "dt_ms": DT * 1e3, "wall_s": round(walls[1], 3),
-            "afferent_s_per_wall_s": round(n * 0.5 / walls[1], 1), "peak_rss_mb": rss}
+            "afferent_s_per_wall_s": round(n * 0.5 / walls[1], 1), "peak_rss_mb": rss,
+            "dask_installed": importlib.util.find_spec("distributed") is not None}
     return case, round(max(0.0, walls[0] - walls[1]), 3)
 
 

@@ -20,6 +20,11 @@ Design (measured on this machine kind, see README "Engines"):
   extra samples come after the end and their spikes are dropped.  The state
   at the true end is captured in ``v_end, u_end`` by the same operation when
   ``t`` reaches ``t_end`` (a run argument), before the padded steps run.
+* **Lanes: runs in parallel.**  The binary is run directly (as Brian2's
+  ``device.run`` does, but without changing the process's working
+  directory), each concurrent caller in its own *lane*: its own input files
+  and its own ``--results_dir``.  Two blocks in flight then integrate on two
+  cores; only generating and compiling a project is serialised.
 * **32-bit TimedArray index.**  Brian2 indexes ``timestep*N + i`` with an
   ``int``; runs are cut into time chunks so that ``n_samples * n_neurons``
   stays far below 2**31.
@@ -31,6 +36,8 @@ import gc
 import hashlib
 import logging
 import os
+import queue
+import subprocess
 import sys
 import threading
 import warnings
@@ -82,22 +89,21 @@ def cache_dir() -> Path:
     return cache_root() / "brian2"
 
 
-@dataclass
+@dataclass(frozen=True)
 class _Build:
-    """A generated and compiled standalone project, live in this process."""
+    """A generated and compiled standalone project: where it is and what its files are called."""
 
     key: tuple
     directory: Path
-    group: object
-    monitor: object
-    device: object  # the cpp_standalone device that built the project
     n_neurons: int
     n_samples: int
-    duration: float  # seconds simulated by one run of the binary
+    results: dict  # result name ("i", "t", "v", "u", "v_end", "u_end") -> file name in a results dir
 
 
-_ACTIVE: _Build | None = None
-_LOCK = threading.RLock()  # Brian2's device is process-global: one run at a time
+_BUILDS: dict = {}  # key -> _Build, for this process
+_LOCK = threading.RLock()  # Brian2's device is process-global: one build at a time
+_FREE_LANES: queue.SimpleQueue = queue.SimpleQueue()
+_LANE_COUNT = [0]
 
 
 def _pad(n: int, quantum: int) -> int:
@@ -220,18 +226,50 @@ def _build(key: tuple) -> _Build:
         net.run(n_samples * substeps * dt * b2.second, namespace={"ddmm_current": ta, "ms": b2.ms})
         standalone.build(directory=str(directory), run=False, with_output=False)
         b2.set_device("runtime")  # leave the user's Brian2 in its default mode
-    return _Build(key, directory, group, monitor, standalone, n_neurons, n_samples, n_samples * substeps * dt)
+        results = {name: standalone.get_array_filename(owner.variables[name])
+                   for owner, names in ((group, ("v", "u", "v_end", "u_end")), (monitor, ("i", "t")))
+                   for name in names}
+    return _Build(key, directory, n_neurons, n_samples, results)
 
 
 def _activate(key: tuple) -> _Build:
-    global _ACTIVE
-    if _ACTIVE is None or _ACTIVE.key != key:
-        _ACTIVE = None  # release the previous build before naming the new one
-        _ACTIVE = _build(key)
-    return _ACTIVE
+    with _LOCK:
+        if key not in _BUILDS:
+            _BUILDS.clear()  # release the previous build's Brian2 objects before naming the new one
+            gc.collect()
+            _BUILDS[key] = _build(key)
+        return _BUILDS[key]
 
 
-def _run_chunk(build: _Build, current, params, v, u):
+@contextmanager
+def _lane():
+    """A lane number no other thread is using: its own input files and results directory."""
+    try:
+        lane = _FREE_LANES.get_nowait()
+    except queue.Empty:
+        with _LOCK:
+            lane = _LANE_COUNT[0]
+            _LANE_COUNT[0] += 1
+    try:
+        yield lane
+    finally:
+        _FREE_LANES.put(lane)
+
+
+def _run_binary(build: _Build, lane: int, run_args: list) -> Path:
+    """Run the compiled binary in ``lane``; return its results directory."""
+    results = build.directory / f"results_{lane}"
+    results.mkdir(exist_ok=True)
+    env = dict(os.environ, LD_BIND_NOW="1")  # Brian2's default run environment
+    proc = subprocess.run(["./main", "--results_dir", f"{results}{os.sep}", *run_args], cwd=build.directory,
+                          env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False)
+    if proc.returncode:
+        raise RuntimeError(f"the Brian2 binary failed (exit {proc.returncode}) in {build.directory}: "
+                           f"{proc.stderr.strip()[-500:]}")
+    return results
+
+
+def _run_chunk(build: _Build, lane: int, current, params, v, u):
     """Run the compiled binary once on a padded chunk; return spikes and final state."""
     static = build.directory / "static_arrays"
     n_real = current.shape[1]
@@ -246,18 +284,20 @@ def _run_chunk(build: _Build, current, params, v, u):
     t_end = current.shape[0] * build.key[2] * build.key[3]  # samples * substeps * dt, in s
     run_args = [f"afferents.t_end={t_end!r}"]
     for target, arr in files.items():
-        fname = f"ddmm_{target.replace('.', '_')}.dat"
+        fname = f"ddmm_{lane}_{target.replace('.', '_')}.dat"
         np.ascontiguousarray(arr, dtype=np.float64).tofile(static / fname)
         run_args.append(f"{target}=static_arrays/{fname}")
-    build.device.run(directory=str(build.directory), with_output=False, run_args=run_args)
-    neuron = np.asarray(build.monitor.i[:], dtype=np.int64)
-    step = np.rint(np.asarray(build.monitor.t_[:]) / (build.key[3])).astype(np.int64)
+    results = _run_binary(build, lane, run_args)
+
+    def read(name, dtype):
+        return np.fromfile(results / build.results[name], dtype=dtype)
+
+    neuron = read("i", np.int32).astype(np.int64)
+    step = np.rint(read("t", np.float64) / build.key[3]).astype(np.int64)
     keep = neuron < n_real
     padded_tail = current.shape[0] < build.n_samples
     v_name, u_name = ("v_end", "u_end") if padded_tail else ("v", "u")
-    v_final = np.asarray(getattr(build.group, v_name)[:])[:n_real]
-    u_final = np.asarray(getattr(build.group, u_name)[:])[:n_real]
-    return neuron[keep], step[keep], v_final, u_final
+    return neuron[keep], step[keep], read(v_name, np.float64)[:n_real], read(u_name, np.float64)[:n_real]
 
 
 def run_brian2(current, substeps, dt, params, v, u, method="euler", v_peak=30.0, v_floor=V_FLOOR):
@@ -268,11 +308,11 @@ def run_brian2(current, substeps, dt, params, v, u, method="euler", v_peak=30.0,
     """
     if v_peak != 30.0 or v_floor != V_FLOOR:
         raise ValueError(f"the Brian2 engine is built for v_peak = 30 and v_floor = {V_FLOOR} mV")
-    with _LOCK:
-        return _run_locked(current, substeps, dt, params, v, u, method)
+    with _lane() as lane:
+        return _run_lanes(lane, current, substeps, dt, params, v, u, method)
 
 
-def _run_locked(current, substeps, dt, params, v, u, method):
+def _run_lanes(lane, current, substeps, dt, params, v, u, method):
     n_samples_total, n_neurons = current.shape
     n_pad = _pad(n_neurons, _NEURON_QUANTUM)
     chunk = max(_SAMPLE_QUANTUM, (_MAX_ELEMENTS // n_pad) // _SAMPLE_QUANTUM * _SAMPLE_QUANTUM)
@@ -281,7 +321,7 @@ def _run_locked(current, substeps, dt, params, v, u, method):
     neurons, steps = [], []
     for start in range(0, n_samples_total, t_pad):
         part = current[start : start + t_pad]
-        nrn, stp, v_new, u_new = _run_chunk(build, part, params, v, u)
+        nrn, stp, v_new, u_new = _run_chunk(build, lane, part, params, v, u)
         n_valid = part.shape[0] * substeps
         keep = stp < n_valid  # spikes in the zero padding after the end are not real
         neurons.append(nrn[keep])

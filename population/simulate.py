@@ -11,6 +11,7 @@ spike.
 
 from __future__ import annotations
 
+import importlib.util
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -351,6 +352,9 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
 def _run_jobs(jobs, config, scheduler, progress) -> list:
     """Results of every job, in order: in this process, or as Dask tasks."""
     if scheduler is not None:
+        if importlib.util.find_spec("distributed") is None:
+            raise ImportError(f"scheduler={scheduler!r} needs Dask's distributed scheduler: "
+                              'pip install "ddmm[dask]"')
         from .distributed import dask_client, run_distributed
 
         with dask_client(scheduler) as client:

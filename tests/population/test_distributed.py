@@ -82,3 +82,12 @@ def test_lost_worker_is_retried(client, pop):
     os.kill(pid, signal.SIGKILL)
     runner.join(timeout=300)
     assert "ds" in out and out["ds"].identical(ref)
+
+
+def test_missing_dask_extra_is_one_line_error(pop, monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "distributed" else real(name, *a))
+    with pytest.raises(ImportError, match=r'pip install "ddmm\[dask\]"'):
+        simulate(pop.select(range(4)), birznieks(90.0), engine="direct", quiet=True, scheduler="processes")
