@@ -37,6 +37,7 @@ import hashlib
 import logging
 import os
 import queue
+import shutil
 import subprocess
 import sys
 import threading
@@ -226,6 +227,10 @@ def _build(key: tuple) -> _Build:
         net.run(n_samples * substeps * dt * b2.second, namespace={"ddmm_current": ta, "ms": b2.ms})
         standalone.build(directory=str(directory), run=False, with_output=False)
         b2.set_device("runtime")  # leave the user's Brian2 in its default mode
+        # Every run hands the binary its current as a run argument, which
+        # the binary loads after its compiled-in default: empty the default
+        # (25 MB of zeros read for nothing on every run otherwise).
+        (directory / "static_arrays" / "ddmm_current_values").write_bytes(b"")
         results = {name: standalone.get_array_filename(owner.variables[name])
                    for owner, names in ((group, ("v", "u", "v_end", "u_end")), (monitor, ("i", "t")))
                    for name in names}
@@ -243,12 +248,12 @@ def _activate(key: tuple) -> _Build:
 
 @contextmanager
 def _lane():
-    """A lane number no other thread is using: its own input files and results directory."""
+    """A lane no other thread or process is using: its own input files and results directory."""
     try:
         lane = _FREE_LANES.get_nowait()
     except queue.Empty:
         with _LOCK:
-            lane = _LANE_COUNT[0]
+            lane = f"{os.getpid()}_{_LANE_COUNT[0]}"
             _LANE_COUNT[0] += 1
     try:
         yield lane
@@ -256,7 +261,7 @@ def _lane():
         _FREE_LANES.put(lane)
 
 
-def _run_binary(build: _Build, lane: int, run_args: list) -> Path:
+def _run_binary(build: _Build, lane: str, run_args: list) -> Path:
     """Run the compiled binary in ``lane``; return its results directory."""
     results = build.directory / f"results_{lane}"
     results.mkdir(exist_ok=True)
@@ -269,7 +274,7 @@ def _run_binary(build: _Build, lane: int, run_args: list) -> Path:
     return results
 
 
-def _run_chunk(build: _Build, lane: int, current, params, v, u):
+def _run_chunk(build: _Build, lane: str, current, params, v, u):
     """Run the compiled binary once on a padded chunk; return spikes and final state."""
     static = build.directory / "static_arrays"
     n_real = current.shape[1]
@@ -283,21 +288,25 @@ def _run_chunk(build: _Build, lane: int, current, params, v, u):
         files[f"afferents.{name}"] = full
     t_end = current.shape[0] * build.key[2] * build.key[3]  # samples * substeps * dt, in s
     run_args = [f"afferents.t_end={t_end!r}"]
+    inputs = []
     for target, arr in files.items():
-        fname = f"ddmm_{lane}_{target.replace('.', '_')}.dat"
-        np.ascontiguousarray(arr, dtype=np.float64).tofile(static / fname)
-        run_args.append(f"{target}=static_arrays/{fname}")
-    results = _run_binary(build, lane, run_args)
-
-    def read(name, dtype):
-        return np.fromfile(results / build.results[name], dtype=dtype)
-
-    neuron = read("i", np.int32).astype(np.int64)
-    step = np.rint(read("t", np.float64) / build.key[3]).astype(np.int64)
+        inputs.append(static / f"ddmm_{lane}_{target.replace('.', '_')}.dat")
+        np.ascontiguousarray(arr, dtype=np.float64).tofile(inputs[-1])
+        run_args.append(f"{target}=static_arrays/{inputs[-1].name}")
+    try:
+        results = _run_binary(build, lane, run_args)
+        read = {name: np.fromfile(results / fname, dtype=np.int32 if name == "i" else np.float64)
+                for name, fname in build.results.items()}
+    finally:  # a lane's files live for one run: nothing accumulates in the cache
+        for path in inputs:
+            path.unlink(missing_ok=True)
+        shutil.rmtree(build.directory / f"results_{lane}", ignore_errors=True)
+    neuron = read["i"].astype(np.int64)
+    step = np.rint(read["t"] / build.key[3]).astype(np.int64)
     keep = neuron < n_real
     padded_tail = current.shape[0] < build.n_samples
     v_name, u_name = ("v_end", "u_end") if padded_tail else ("v", "u")
-    return neuron[keep], step[keep], read(v_name, np.float64)[:n_real], read(u_name, np.float64)[:n_real]
+    return neuron[keep], step[keep], read[v_name][:n_real], read[u_name][:n_real]
 
 
 def run_brian2(current, substeps, dt, params, v, u, method="euler", v_peak=30.0, v_floor=V_FLOOR):

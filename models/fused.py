@@ -32,7 +32,7 @@ import numpy as np
 from ._stage_kernels import filter_sections, receptor_noise_keyed, stage_tail, transduce_inplace
 from .attenuation import UNTUNED, profile_value
 from .currents import _stage_constants
-from .direct import _BLOCK, _METHOD_CODES, _integrate_range
+from .direct import _BLOCK, _METHOD_CODES, _integrate_range, integrate_parts, part_bounds
 from .engines import NeuronState, check_integration, check_stability, integrate, substeps_for
 from .nap import get_profile, tip_radius
 from .neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
@@ -239,16 +239,21 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f
 
 @nb.njit(cache=True, nogil=True)
 def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i, sigma_idx,
-                        substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block):
-    """`_back`, then the direct engine on the current.
+                        substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, bounds):
+    """`_back`, then the direct engine on the current (on the column ranges ``bounds`` in parallel
+    when there are several).
 
     Returns spikes, the smallest current, whether the state stayed finite and
     whether a neuron spiked on consecutive steps (the one-spike-per-step cap
     bound): the seam's checks need the full spike lists only then.
     """
     lowest = _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i, sigma_idx)
-    idx, stp = _integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, 0,
-                                v.size)
+    if bounds.size > 2:
+        idx, stp = integrate_parts(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
+                                   bounds)
+    else:
+        idx, stp = _integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
+                                    0, v.size)
     finite = True
     for j in range(v.size):
         if not (math.isfinite(v[j]) and math.isfinite(u[j])):
@@ -361,13 +366,14 @@ class FusedPlan:
                            st.tau_s is not None, tuned[a], a, b]
         return grp_f, grp_i, sos_all
 
-    def advance(self, forces, state, sample0, key, neuron, *, dt, method, engine):
+    def advance(self, forces, state, sample0, key, neuron, *, dt, method, engine, parts=1):
         """One chunk through the whole pipeline: (afferent, step within the chunk, neuron state after).
 
         ``forces`` and ``key`` as `currents`; ``sample0`` is the chunk's first
         sample (0 starts the filters at rest on it); ``neuron`` the
         `NeuronState` before (None: at rest).  The direct engine runs fused
-        (`spikes`) with the seam's checks; other engines get the currents.
+        (`spikes`) with the seam's checks, integrating ``parts`` column ranges
+        in parallel; other engines get the currents.
         """
         started = sample0 > 0
         if engine != "direct":
@@ -381,7 +387,7 @@ class FusedPlan:
         else:
             v, u = neuron.v.copy(), neuron.u.copy()
         current, afferent, step, lowest, finite, capped = self.spikes(forces, state, started, sample0, key, args, v,
-                                                                     u)
+                                                                     u, parts)
         if method != "euler":
             check_stability(np.array([lowest]), dt, method)
         if not finite or capped:
@@ -430,16 +436,20 @@ class FusedPlan:
               self.rows, self.aff_f, self.aff_i, self.grp_f, self.grp_i, self.sigma_idx)
         return current
 
-    def spikes(self, forces, state, started, sample0, key, neuron, v, u):
+    def spikes(self, forces, state, started, sample0, key, neuron, v, u, parts=1):
         """Currents, then the direct engine: (current, afferent, step, smallest current, finite, capped).
 
         Arguments as `currents`; ``neuron`` is (substeps, method code, h,
         half, a, b, c, d, v_peak, v_floor, block) as `models.direct` takes
-        them; ``v``, ``u`` and ``state`` are updated in place.
+        them; ``v``, ``u`` and ``state`` are updated in place.  With
+        ``parts`` > 1 the integration runs on that many column ranges in
+        parallel (the spikes are the same, ordered range by range).
         """
         current = self._drive(forces, state, started, sample0, key)
         substeps, method, h, half, a, b, c, d, v_peak, v_floor, block = neuron
+        bounds = part_bounds(v.size, parts)
         out = _back_and_integrate(current, np.uint64(key or 0), key is not None and self.additive, self.afferent_id,
                                   int(sample0), state, self.rows, self.aff_f, self.aff_i, self.grp_f, self.grp_i,
-                                  self.sigma_idx, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block)
+                                  self.sigma_idx, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
+                                  bounds)
         return (current, *out)

@@ -7,7 +7,9 @@ afferent a is a pure function of (seed, condition 0, trial 0, a, n)
 (`population.noise`), drawn on demand inside the kernel.  So the
 concatenated spikes of *any* chunking equal the offline run of the whole
 signal with the same seed, bit for bit, with no noise drawn ahead, no
-background thread and no queue.
+background thread and no queue.  From `PARALLEL_MIN_AFFERENTS` afferents a
+push integrates its neurons on every core (``DDMM_NUM_THREADS``) in one
+numba parallel region; neurons are independent, so no spike changes.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import numpy as np
 from models._validation import as_finite_array, check_choice, check_positive
 from models.attenuation import NO_SHEAR_READINGS
 from models.currents import check_fs
+from models.direct import default_threads
 from models.engines import ENGINES, METHODS, prepare, substeps_for
 
 from .noise import noise_key, root_seed
@@ -28,6 +31,9 @@ from .simulate import _grouped, block_plan
 from .spatial import receptive_field_weight, site_coverage
 
 __all__ = ["StreamSpikes", "Encoder"]
+
+#: Afferents from which a push integrates on every core (numba threads): below, one core is faster.
+PARALLEL_MIN_AFFERENTS = 4096
 
 @dataclass(frozen=True)
 class StreamSpikes:
@@ -169,8 +175,9 @@ class Encoder:
         if n == 0:
             return StreamSpikes(np.empty(0, np.int64), np.empty(0))
         state = self._state.copy()  # committed only if the whole chunk succeeds
+        parts = default_threads() if len(self._order) >= PARALLEL_MIN_AFFERENTS else 1
         afferent, step, neuron = self._plan.advance(forces, state, self._samples, self._key, self._neuron, dt=self.dt,
-                                                    method=self.method, engine=self.engine)
+                                                    method=self.method, engine=self.engine, parts=parts)
         step0 = self._samples * self.substeps
         self._state, self._neuron = state, neuron
         self._samples += n

@@ -37,6 +37,20 @@ def test_any_chunking_equals_offline(setup, cuts, engine):
     np.testing.assert_array_equal(t, offline[engine].spike_time.values)
 
 
+@pytest.mark.parametrize("threads", ["2", "3"])
+def test_parallel_push_equals_offline(setup, monkeypatch, threads):
+    """A large population's pushes integrate on several numba threads: the spikes stay the offline ones."""
+    import population.stream as stream
+
+    monkeypatch.setattr(stream, "PARALLEL_MIN_AFFERENTS", 1)
+    monkeypatch.setenv("DDMM_NUM_THREADS", threads)
+    pop, forces, offline = setup
+    enc = Encoder(pop, 1000.0, engine="direct", seed=3)
+    aff, t = concat([enc.push(forces[a:a + 7]) for a in range(0, N, 7)])
+    np.testing.assert_array_equal(aff, offline["direct"].spike_afferent.values)
+    np.testing.assert_array_equal(t, offline["direct"].spike_time.values)
+
+
 def test_bad_chunks_do_not_corrupt_the_state(setup):
     pop, forces, offline = setup
     enc = Encoder(pop, 1000.0, engine="direct", seed=3)
