@@ -266,6 +266,10 @@ def _run_binary(build: _Build, lane: str, run_args: list) -> Path:
     results = build.directory / f"results_{lane}"
     results.mkdir(exist_ok=True)
     env = dict(os.environ, LD_BIND_NOW="1")  # Brian2's default run environment
+    # The binary allocates its 25 MB current table afresh on every run: on
+    # transparent huge pages its page faults cost ~30% less of the run
+    # (glibc >= 2.35; ignored elsewhere, and the arithmetic is the same).
+    env["GLIBC_TUNABLES"] = ":".join(filter(None, [env.get("GLIBC_TUNABLES", ""), "glibc.malloc.hugetlb=1"]))
     proc = subprocess.run(["./main", "--results_dir", f"{results}{os.sep}", *run_args], cwd=build.directory,
                           env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False)
     if proc.returncode:
