@@ -239,21 +239,25 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f
 
 @nb.njit(cache=True, nogil=True)
 def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i, sigma_idx,
-                        substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, bounds):
-    """`_back`, then the direct engine on the current (on the column ranges ``bounds`` in parallel
-    when there are several).
+                        substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, integrate):
+    """`_back`, then (if ``integrate``) the direct engine on the current.
 
     Returns spikes, the smallest current, whether the state stayed finite and
     whether a neuron spiked on consecutive steps (the one-spike-per-step cap
     bound): the seam's checks need the full spike lists only then.
     """
     lowest = _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i, sigma_idx)
-    if bounds.size > 2:
-        idx, stp = integrate_parts(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
-                                   bounds)
-    else:
-        idx, stp = _integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
-                                    0, v.size)
+    if not integrate:
+        return np.empty(0, np.int64), np.empty(0, np.int64), lowest, True, False
+    idx, stp = _integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, 0,
+                                v.size)
+    finite, capped = _spike_checks(idx, stp, v, u)
+    return idx, stp, lowest, finite, capped
+
+
+@nb.njit(cache=True, nogil=True)
+def _spike_checks(idx, stp, v, u):
+    """Whether the state stayed finite, and whether a neuron spiked on consecutive steps."""
     finite = True
     for j in range(v.size):
         if not (math.isfinite(v[j]) and math.isfinite(u[j])):
@@ -263,7 +267,7 @@ def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f
         if stp[k] == last[idx[k]] + 1:
             capped = True
         last[idx[k]] = stp[k]
-    return idx, stp, lowest, finite, capped
+    return finite, capped
 
 
 class FusedPlan:
@@ -448,8 +452,15 @@ class FusedPlan:
         current = self._drive(forces, state, started, sample0, key)
         substeps, method, h, half, a, b, c, d, v_peak, v_floor, block = neuron
         bounds = part_bounds(v.size, parts)
+        serial = bounds.size <= 2
         out = _back_and_integrate(current, np.uint64(key or 0), key is not None and self.additive, self.afferent_id,
                                   int(sample0), state, self.rows, self.aff_f, self.aff_i, self.grp_f, self.grp_i,
                                   self.sigma_idx, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
-                                  bounds)
+                                  serial)
+        if not serial:
+            # Called from Python, not from a cached kernel: numba's cache does not
+            # track a caller's parallel callee (a stale one crashed).
+            idx, stp = integrate_parts(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
+                                       bounds)
+            out = (idx, stp, out[2], *_spike_checks(idx, stp, v, u))
         return (current, *out)
