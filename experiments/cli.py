@@ -17,7 +17,8 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand registered."""
-    from . import bench, cmd_accuracy, cmd_biology, cmd_physiology, cmd_population, cmd_reproduce, cmd_stream
+    from . import (bench, cmd_accuracy, cmd_biology, cmd_export, cmd_physiology, cmd_population, cmd_reproduce,
+                   cmd_stream)
 
     parser = _Parser(
         prog="ddmm",
@@ -25,17 +26,20 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                 parser_class=_Parser)
-    for module in (cmd_reproduce, cmd_population, cmd_biology, cmd_physiology, cmd_accuracy, cmd_stream, bench):
+    for module in (cmd_reproduce, cmd_population, cmd_biology, cmd_physiology, cmd_accuracy, cmd_stream, cmd_export,
+                   bench):
         module.register(sub)
     return parser
 
 
 def main(argv=None) -> int:
     """Entry point of the ``ddmm`` console script."""
+    from population._extras import MissingExtraError
+
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args) or 0)
-    except (ValueError, TypeError) as exc:
+    except (ValueError, TypeError, MissingExtraError) as exc:  # a missing extra says which to install
         print(f"ddmm: error: {exc}", file=sys.stderr)
         return 2
     except OSError as exc:

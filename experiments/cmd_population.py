@@ -10,7 +10,7 @@ from population.arrays import EXTENSIONS
 
 from .io import ensure_out_dir, save_figure
 
-__all__ = ["register", "register_demo", "scenes_from_args", "write_plots"]
+__all__ = ["check_out_file", "register", "register_demo", "scenes_from_args", "write_plots"]
 
 SCENES = ("birznieks", "press-push-lift", "rotating-shear")
 
@@ -135,27 +135,27 @@ def _population(args):
     return sample_population(load_spec(args.population), rng=args.seed)
 
 
-def _check_out_file(path) -> Path:
-    """Fail before simulating if ``path`` cannot be written (a probe file is created)."""
+def check_out_file(path, suffix: str = ".nc", option: str = "--out") -> Path:
+    """Fail before the work if ``path`` cannot be written (a probe file is created)."""
     import tempfile
 
     path = Path(path)
-    if path.suffix != ".nc":
-        raise ValueError(f"--out {str(path)!r} must end in .nc")
+    if path.suffix != suffix:
+        raise ValueError(f"{option} {str(path)!r} must end in {suffix}")
     if not path.parent.is_dir():
-        raise ValueError(f"--out {str(path)!r}: directory {str(path.parent)!r} does not exist")
+        raise ValueError(f"{option} {str(path)!r}: directory {str(path.parent)!r} does not exist")
     try:
         with tempfile.NamedTemporaryFile(dir=path.parent, prefix=".ddmm-probe-"):
             pass
     except OSError as exc:
-        raise ValueError(f"--out {str(path)!r}: directory {str(path.parent)!r} is not writable "
+        raise ValueError(f"{option} {str(path)!r}: directory {str(path.parent)!r} is not writable "
                          f"({exc.strerror})") from None
     return path
 
 
 def run_simulate(args) -> int:
     from population import save_dataset, simulate
-    out = _check_out_file(args.out)
+    out = check_out_file(args.out)
     pop, scenes = _population(args), scenes_from_args(args)
     start = time.perf_counter()
     ds = simulate(pop, scenes, engine=args.engine, dt=None if args.dt is None else args.dt * 1e-3,

@@ -10,6 +10,8 @@ from models._lazy import lazy_exports
 _WHERE = {
     "arrays": ("from_array", "from_long_csv", "save_array"),
     "dataset": ("binned_counts", "binned_rates", "describe_dataset", "load_dataset", "psth", "save_dataset"),
+    "neo_export": ("to_neo",),
+    "nwb": ("to_nwb",),
     "plan": ("make_plan",),
     "sampling": ("Population", "make_population", "sample_population"),
     "scenes": ("Contact", "Scene", "Sites", "Stage", "birznieks", "from_csv", "press_push_lift", "rotating_shear",

@@ -16,15 +16,16 @@ def _umask_mode() -> int:
     return 0o666 & ~mask
 
 
-def atomic_write(path, write) -> Path:
+def atomic_write(path, write, *, suffix: str = ".part") -> Path:
     """Call ``write(tmp_path)`` then rename the temporary file onto ``path``.
 
     The temporary file lives in the target's directory, so the rename is
     atomic; on any error it is removed and ``path`` is left untouched.  The
     file gets the usual permissions (``mkstemp`` would leave it owner-only).
+    ``suffix`` ends the temporary name (a writer may insist on an extension).
     """
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent if str(path.parent) else ".", prefix=f".{path.name}.", suffix=".part")
+    fd, tmp = tempfile.mkstemp(dir=path.parent if str(path.parent) else ".", prefix=f".{path.name}.", suffix=suffix)
     os.close(fd)
     try:
         write(tmp)

@@ -219,7 +219,7 @@ def binned_counts(ds: xr.Dataset, bin_s: float, *, t_max: float | None = None) -
     t_max = float(ds.duration.max()) if t_max is None else t_max
     edges = np.arange(0.0, t_max + bin_s / 2, bin_s)
     n_bins = max(1, edges.size - 1)
-    b = np.minimum((ds.spike_time.values // bin_s).astype(np.int64), n_bins - 1)
+    b = np.minimum(_bin_index(ds.spike_time.values, bin_s), n_bins - 1)
     keep = ds.spike_time.values < edges[-1]
     shape = (ds.sizes["condition"], ds.sizes["trial"], ds.sizes["afferent"], n_bins)
     out = np.zeros(shape, np.int32)
@@ -230,6 +230,19 @@ def binned_counts(ds: xr.Dataset, bin_s: float, *, t_max: float | None = None) -
                         coords={**{k: ds[k] for k in ("condition", "trial")}, **ds.afferent.coords,
                                 "bin": ("bin", centers, {"units": "s"})},
                         attrs={"units": "1", "bin_s": bin_s})
+
+
+def _bin_index(t, bin_s: float) -> np.ndarray:
+    """Bin of each time in half-open bins ``[i, i + 1) * bin_s``; a time on an edge to rounding opens the next.
+
+    Spike times are step counts times dt, so many fall on bin edges:
+    ``5.97 // 0.01`` is 596.0, and 5.97 s would land in the bin before its
+    own.  A quotient within 1e-8 bins of an integer is taken as that integer
+    (Elephant's ``BinnedSpikeTrain`` tolerance, so the two bin alike).
+    """
+    q = np.asarray(t, np.float64) / bin_s
+    nearest = np.rint(q)
+    return np.floor(np.where(np.abs(q - nearest) <= 1e-8, nearest, q)).astype(np.int64)
 
 
 def binned_rates(ds: xr.Dataset, bin_s: float, **kwargs) -> xr.DataArray:

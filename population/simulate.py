@@ -24,6 +24,7 @@ from models.currents import check_fs
 from models.engines import ENGINES, METHODS, prepare, substeps_for
 from models.fused import FusedPlan, mixing_matrix
 
+from ._extras import MissingExtraError
 from .noise import noise_key, root_seed
 from .plan import RECORD_CHOICES, make_plan
 from .sampling import Population
@@ -353,8 +354,8 @@ def _run_jobs(jobs, config, scheduler, progress) -> list:
     """Results of every job, in order: in this process, or as Dask tasks."""
     if scheduler is not None:
         if importlib.util.find_spec("distributed") is None:
-            raise ImportError(f"scheduler={scheduler!r} needs Dask's distributed scheduler: "
-                              'pip install "ddmm[dask]"')
+            raise MissingExtraError(f"scheduler={scheduler!r} needs Dask's distributed scheduler: "
+                                    'pip install "ddmm[dask]"')
         from .distributed import dask_client, run_distributed
 
         with dask_client(scheduler) as client:

@@ -29,12 +29,14 @@ def test_docstring_examples(module_name):
 
 
 def test_packages_import_lazily_and_keep_their_names():
-    """``import population`` loads no xarray, scipy.signal or Brian2; ``population.simulate`` stays the function."""
+    """``import population`` loads no xarray, scipy.signal, Brian2, pynwb or neo; ``simulate`` stays the function."""
     import subprocess
     import sys
 
-    code = ("import sys, population; heavy = [m for m in ('xarray', 'scipy.signal', 'brian2', 'dask') if m in sys.modules];"
-            "import population.simulate; from population import simulate;"
-            "print(heavy, callable(simulate) and simulate.__name__ == 'simulate')")
+    code = ("import sys, population; heavy = [m for m in ('xarray', 'scipy.signal', 'brian2', 'dask', 'pynwb', 'neo')"
+            " if m in sys.modules];"
+            "import population.simulate; from population import simulate, to_neo, to_nwb;"
+            "print(heavy, callable(simulate) and simulate.__name__ == 'simulate',"
+            " [m for m in ('pynwb', 'neo') if m in sys.modules])")  # the exporters import theirs when called
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
-    assert out == "[] True"
+    assert out == "[] True []"

@@ -18,6 +18,14 @@ def test_binned_counts_sum_to_spike_counts(ds):
     assert counts.sizes["bin"] == 10 and counts.bin.values[0] == pytest.approx(0.025)
 
 
+def test_spike_on_a_bin_edge_opens_the_next_bin(ds):
+    # 5.97 // 0.01 == 596.0 in float64: without the snap the spike at 5.97 s fell into [5.96, 5.97).
+    one = ds.isel(spike=[0]).assign(spike_time=("spike", [5.97]), spike_afferent=("spike", [0]),
+                                    spike_trial=("spike", [0]), spike_condition=("spike", [0]))
+    counts = binned_counts(one, 0.01, t_max=6.0).isel(condition=0, trial=0, afferent=0).values
+    assert np.flatnonzero(counts).tolist() == [597]
+
+
 def test_psth_is_mean_rate_per_type(ds):
     rates = psth(ds, 0.1)
     assert set(rates.afferent_type.values) == {"SAI", "RAI"}
