@@ -16,6 +16,10 @@ into tables:
 3. **back** (one numba pass): the current's low-pass, the bias and the
    additive noise, then the direct engine's integrator.
 
+For the streaming encoder's large populations, both passes also run on
+afferent ranges in parallel (`_front_parts`, `models.direct.integrate_parts`):
+afferents are independent, so the bits are the same.
+
 Because the scalar helpers are the very functions the per-stage kernels
 call, and every operation keeps their order, the result is bit-identical to
 the stage-by-stage path (``tests/population/test_stream.py`` holds the
@@ -128,15 +132,15 @@ def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_readin
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _mix_sample(forces_i, weights, out):
-    """``out[axis, a] = sum_s weights[s, a] forces_i[s, axis]``, over sites in increasing order."""
+def _mix_sample(forces_i, weights, out, a0, a1):
+    """``out[axis, a] = sum_s weights[s, a] forces_i[s, axis]`` for afferents a0..a1, over sites in increasing order."""
     for axis in range(3):
         row = out[axis]
-        row[:] = 0.0
+        row[a0:a1] = 0.0
         for s in range(weights.shape[0]):
             c = forces_i[s, axis]
             if c != 0.0:  # adding 0 * w leaves every sum as it is
-                for j in range(weights.shape[1]):
+                for j in range(a0, a1):
                     row[j] += weights[s, j] * c
 
 
@@ -151,16 +155,37 @@ def mix_forces(forces, weights):
     out = np.empty((forces.shape[0], 3, weights.shape[1]))
     local = np.empty((3, weights.shape[1]))
     for i in range(forces.shape[0]):
-        _mix_sample(forces[i], weights, local)
+        _mix_sample(forces[i], weights, local, 0, weights.shape[1])
         out[i] = local
     return out
 
 
 @nb.njit(cache=True, nogil=True)
 def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f, grp_i,
-           sos, fs,
-           smooth_reading, outside_value, f_th, opponent):
-    """Force to linear drive (n, n_afferents); ``state`` updated in place.
+           sos, fs, smooth_reading, outside_value, f_th, opponent):
+    """Force to linear drive (n, n_afferents); ``state`` updated in place (`_front_range` on every afferent)."""
+    out = np.empty((forces.shape[0] if not mixed else sites.shape[0], aff_i.shape[1]))
+    _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f,
+                 grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, 0, aff_i.shape[1])
+    return out
+
+
+@nb.njit(cache=True, nogil=True, parallel=True)
+def _front_parts(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f,
+                 grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, bounds):
+    """`_front` with the afferent ranges ``bounds[p]..bounds[p+1]`` in parallel (afferents are independent)."""
+    out = np.empty((forces.shape[0] if not mixed else sites.shape[0], aff_i.shape[1]))
+    for p in nb.prange(bounds.size - 1):
+        _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i,
+                     grp_f, grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, bounds[p],
+                     bounds[p + 1])
+    return out
+
+
+@nb.njit(cache=True, nogil=True)
+def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f,
+                 grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, a0, a1):
+    """Force to linear drive of the afferents ``a0..a1`` into ``out`` (n, n_afferents); their ``state`` in place.
 
     ``forces`` (n, 3) is felt by every afferent, or with ``mixed`` each
     afferent feels its own mix (``weights``, (n_sites, n_afferents)) of the
@@ -168,21 +193,23 @@ def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, s
     one type, tuned or not) are the outer loop, so each inner loop over
     afferents has loop-invariant constants and branches.
     """
-    n, m, rows = forces.shape[0] if not mixed else sites.shape[0], aff_i.shape[1], 2 * sos.shape[1]
+    n, m, rows = out.shape[0], aff_i.shape[1], 2 * sos.shape[1]
     z, offset = state[:rows], state[rows + _OFFSET]
     y1, y2, slow = state[rows + _Y1], state[rows + _Y2], state[rows + _SLOW]
-    out, f, words, xi = np.empty((n, m)), np.empty(m), np.empty(m, np.uint64), np.empty(m)
+    f, words, xi = np.empty(m), np.empty(m, np.uint64), np.empty(m)
     mags, wts, local = np.empty(m), np.empty(m), np.empty((3, m))
     gain, cv_scale, two_fth = aff_f[_GAIN], aff_f[_CV], 2.0 * f_th
     for i in range(n):
         fz, mag, ux, uy, w = 0.0, 0.0, 0.0, 0.0, 0.0
         if mixed:
-            _mix_sample(sites[i], weights, local)
+            _mix_sample(sites[i], weights, local, a0, a1)
         else:
             fz = forces[i, 2]
             mag, ux, uy, w = _shear(forces[i, 0], forces[i, 1], two_fth)
         for g in range(grp_i.shape[1]):
-            lo, hi = grp_i[_START, g], grp_i[_STOP, g]
+            lo, hi = max(a0, grp_i[_START, g]), min(a1, grp_i[_STOP, g])
+            if lo >= hi:
+                continue
             tuned, stretch = grp_i[_TUNED_G, g] != 0, grp_i[_SIGNED, g] != 0
             if mixed:
                 _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_reading, outside_value,
@@ -203,8 +230,7 @@ def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, s
             if noisy_any and grp_i[_NOISY, g] != 0:
                 receptor_noise_keyed(f, lo, hi, key, ids, sample0 + i, cv_scale, grp_i[_SIGNED, g] != 0, words,
                                      xi)
-        out[i] = f
-    return out
+        out[i, a0:a1] = f[a0:a1]
 
 
 @nb.njit(cache=True, nogil=True)
@@ -412,15 +438,18 @@ class FusedPlan:
         """Filter, offset, difference, adaptation and smoothing state at rest, shape (n_rows, n_afferents)."""
         return np.zeros((self.rows + 5, self.n_afferents))
 
-    def _drive(self, forces, state, started, sample0, key):
+    def _drive(self, forces, state, started, sample0, key, bounds=None):
         noisy, mixed = key is not None, self.mixing is not None
         if forces.ndim != (3 if mixed else 2):
             raise ValueError(f"forces must be {'(n, n_sites, 3) site forces' if mixed else '(n, 3)'} for this plan, "
                              f"got shape {forces.shape}")
-        drive = _front(_NO_FORCES if mixed else forces, forces if mixed else _NO_SITES,
-                       self.mixing if mixed else _NO_WEIGHTS, mixed, np.uint64(key or 0), noisy, self.afferent_id,
-                       int(sample0), state, started, self.aff_f, self.aff_i, self.grp_f, self.grp_i, self.sos,
-                       self.fs, self.smooth_reading, self.outside_value, self.f_th, self.opponent)
+        args = (_NO_FORCES if mixed else forces, forces if mixed else _NO_SITES, self.mixing if mixed else _NO_WEIGHTS,
+                mixed, np.uint64(key or 0), noisy, self.afferent_id, int(sample0), state, started, self.aff_f,
+                self.aff_i, self.grp_f, self.grp_i, self.sos, self.fs, self.smooth_reading, self.outside_value,
+                self.f_th, self.opponent)
+        # The parallel kernel is called from here, never from a cached kernel
+        # (numba's cache does not track a cached caller's parallel callee).
+        drive = _front(*args) if bounds is None or bounds.size <= 2 else _front_parts(*args, bounds)
         for cols, stage in self.transducers:
             transduce_inplace(drive[:, cols], stage)
         return drive
@@ -449,17 +478,15 @@ class FusedPlan:
         ``parts`` > 1 the integration runs on that many column ranges in
         parallel (the spikes are the same, ordered range by range).
         """
-        current = self._drive(forces, state, started, sample0, key)
-        substeps, method, h, half, a, b, c, d, v_peak, v_floor, block = neuron
         bounds = part_bounds(v.size, parts)
+        current = self._drive(forces, state, started, sample0, key, bounds)
+        substeps, method, h, half, a, b, c, d, v_peak, v_floor, block = neuron
         serial = bounds.size <= 2
         out = _back_and_integrate(current, np.uint64(key or 0), key is not None and self.additive, self.afferent_id,
                                   int(sample0), state, self.rows, self.aff_f, self.aff_i, self.grp_f, self.grp_i,
                                   self.sigma_idx, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
                                   serial)
-        if not serial:
-            # Called from Python, not from a cached kernel: numba's cache does not
-            # track a caller's parallel callee (a stale one crashed).
+        if not serial:  # from Python, as the front's parallel kernel
             idx, stp = integrate_parts(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
                                        bounds)
             out = (idx, stp, out[2], *_spike_checks(idx, stp, v, u))
