@@ -123,8 +123,8 @@ def _condition_coords(scenes) -> dict:
     }
 
 
-def _events(plan, spikes, dt):
-    """Concatenate per-condition spikes, keep requested afferents, sort."""
+def _events(plan, spikes):
+    """Concatenate per-condition spikes, keep requested afferents, sort: (condition, trial, step, afferent)."""
     remap = np.full(plan.selected.size, -1, np.int64)
     remap[plan.keep] = np.arange(plan.keep.size)
     cols = [[], [], [], []]
@@ -135,16 +135,27 @@ def _events(plan, spikes, dt):
             for col, arr in zip(cols, (np.full(ok.sum(), c), trial[ok], step[ok], aff[ok])):
                 col.append(np.asarray(arr, np.int64))
     cond, trial, step, aff = (np.concatenate(c) if c else np.empty(0, np.int64) for c in cols)
-    order = np.lexsort((aff, step, trial, cond))
-    return cond[order], trial[order], step[order] * dt, aff[order]
+    return _sorted_events(cond, trial, step, aff, plan.trials, plan.keep.size)
+
+
+def _sorted_events(cond, trial, step, aff, n_trials: int, n_afferents: int):
+    """The events sorted by condition, trial, step and afferent (one sort of a packed key when it fits)."""
+    n_steps = int(step.max()) + 1 if step.size else 1
+    if (int(cond.max()) + 1 if cond.size else 1) * n_trials * n_steps * n_afferents < 2**62:
+        key = ((cond * n_trials + trial) * n_steps + step) * n_afferents + aff  # unique per event
+        order = np.argsort(key)
+    else:  # a packed key would overflow int64
+        order = np.lexsort((aff, step, trial, cond))
+    return cond[order], trial[order], step[order], aff[order]
 
 
 def build_dataset(population, scenes, plan, spikes, config) -> xr.Dataset:
     """Assemble the Dataset of a run (schema in the module docstring)."""
-    cond, trial, time, aff = _events(plan, spikes, config.dt)
+    cond, trial, step, aff = _events(plan, spikes)
+    time = step * config.dt
     n_c, n_t, n_a = len(scenes), plan.trials, plan.keep.size
-    counts = np.zeros((n_c, n_t, n_a), np.int32)
-    np.add.at(counts, (cond, trial, aff), 1)
+    counts = np.bincount((cond * n_t + trial) * n_a + aff, minlength=n_c * n_t * n_a).astype(np.int32)
+    counts = counts.reshape(n_c, n_t, n_a)
     data = {"spike_count": xr.Variable(("condition", "trial", "afferent"), counts, {"units": "1"})}
     if "spikes" in plan.record:
         data["spike_time"] = xr.Variable("spike", time, {"units": "s"})

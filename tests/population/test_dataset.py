@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from population import binned_counts, birznieks, make_population, psth, simulate
 
@@ -38,3 +40,19 @@ def test_rates_need_events(ds):
         binned_counts(ds, 0.0)
     with pytest.raises(ValueError, match="spike events"):
         binned_counts(ds.drop_vars("spike_time"), 0.1)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.tuples(st.integers(0, 3), st.integers(0, 2), st.integers(0, 10**6), st.integers(0, 50)),
+                max_size=60, unique=True),
+       st.sampled_from([10**6 + 1, 10**17]))
+def test_events_sort_like_lexsort(events, n_steps_bound):
+    """The packed-key sort (and its lexsort fallback when the key would overflow) orders like lexsort."""
+    from population.dataset import _sorted_events
+
+    cond, trial, step, aff = (np.array([e[i] for e in events], np.int64) for i in range(4))
+    if step.size:
+        step[0] = n_steps_bound - 1  # sets n_steps: 10**17 forces the fallback
+    order = np.lexsort((aff, step, trial, cond))
+    for got, want in zip(_sorted_events(cond, trial, step, aff, 3, 51), (cond, trial, step, aff)):
+        np.testing.assert_array_equal(got, want[order])
