@@ -172,7 +172,8 @@ def run_simulate(args) -> int:
 def run_plan(args) -> int:
     from population import plan_run
     pop, scenes = _population(args), scenes_from_args(args)
-    the_plan = plan_run(pop, scenes, trials=args.trials, no_shear=args.no_shear, types=_types(args.types))
+    the_plan = plan_run(pop, scenes, trials=args.trials, no_shear=args.no_shear, types=_types(args.types),
+                        engine=args.engine, scheduler=args.scheduler)
     print(the_plan.describe(pop, scenes))
     if args.tolerance is not None:
         from population.accuracy import choose_setting

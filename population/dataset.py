@@ -142,11 +142,17 @@ def _sorted_events(cond, trial, step, aff, n_trials: int, n_afferents: int):
     """The events sorted by condition, trial, step and afferent (one sort of a packed key when it fits)."""
     n_steps = int(step.max()) + 1 if step.size else 1
     if (int(cond.max()) + 1 if cond.size else 1) * n_trials * n_steps * n_afferents < 2**62:
-        key = ((cond * n_trials + trial) * n_steps + step) * n_afferents + aff  # unique per event
-        order = np.argsort(key)
+        order = np.argsort(_packed(_packed(_packed(cond, trial, n_trials), step, n_steps), aff, n_afferents))
     else:  # a packed key would overflow int64
         order = np.lexsort((aff, step, trial, cond))
     return cond[order], trial[order], step[order], aff[order]
+
+
+def _packed(high, low, n_low: int) -> np.ndarray:
+    """``high * n_low + low`` in one new int64 array (long runs have millions of events: no temporaries)."""
+    out = np.multiply(high, n_low, dtype=np.int64)
+    out += low
+    return out
 
 
 def build_dataset(population, scenes, plan, spikes, config) -> xr.Dataset:
@@ -154,7 +160,7 @@ def build_dataset(population, scenes, plan, spikes, config) -> xr.Dataset:
     cond, trial, step, aff = _events(plan, spikes)
     time = step * config.dt
     n_c, n_t, n_a = len(scenes), plan.trials, plan.keep.size
-    counts = np.bincount((cond * n_t + trial) * n_a + aff, minlength=n_c * n_t * n_a).astype(np.int32)
+    counts = np.bincount(_packed(_packed(cond, trial, n_t), aff, n_a), minlength=n_c * n_t * n_a).astype(np.int32)
     counts = counts.reshape(n_c, n_t, n_a)
     data = {"spike_count": xr.Variable(("condition", "trial", "afferent"), counts, {"units": "1"})}
     if "spikes" in plan.record:

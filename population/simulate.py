@@ -32,9 +32,25 @@ from .scenes import Scene
 from .spatial import frame_theta, local_mixing
 
 __all__ = ["SimConfig", "ChunkJob", "run_chunk", "simulate", "plan_run", "population_currents", "block_plan",
-           "chunk_forces"]
+           "chunk_forces", "default_chunk_size"]
 
 _PIPELINE = 2  # afferent blocks in flight at once
+#: Default afferents per block.  The direct engine in process runs small blocks: a block's
+#: filter and neuron state then stay in L2 and both threads stay busy to the end (the hand
+#: x 1 s: 0.18 s with 4096, 0.155-0.165 s with 512).  Brian2 and Dask take large ones: each
+#: block is a run of the binary (and a compiled shape) or a task.
+CHUNK_SIZE = {"direct": 512, "other": 4096}
+
+
+def default_chunk_size(engine: str, scheduler=None) -> int:
+    """Afferents per block when ``chunk_size`` is not given (`CHUNK_SIZE`).
+
+    Examples
+    --------
+    >>> default_chunk_size("direct"), default_chunk_size("brian2"), default_chunk_size("direct", "processes")
+    (512, 4096, 4096)
+    """
+    return CHUNK_SIZE["direct" if engine == "direct" and scheduler is None else "other"]
 
 
 @dataclass(frozen=True)
@@ -202,15 +218,18 @@ def _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_si
     check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
     substeps_for(scenes[0].fs, check_positive(dt, "dt", "s"))
     for name, value in (("trials", trials), ("chunk_size", chunk_size), ("time_chunk", time_chunk)):
+        if name == "chunk_size" and value is None:
+            continue  # the engine's default
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
             raise ValueError(f"{name} must be a whole number >= 1, got {value!r}")
     return scenes
 
 
 def plan_run(population, scenes, *, trials=1, record=RECORD_CHOICES, no_shear="smooth", types=None,
-             chunk_size=4096, time_chunk=2000, plan=True):
+             chunk_size=None, time_chunk=2000, plan=True, engine="brian2", scheduler=None):
     """The `Plan` that `simulate` would follow (print it with ``plan.describe``)."""
     scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
+    chunk_size = default_chunk_size(engine, scheduler) if chunk_size is None else chunk_size
     return make_plan(population, scenes, types=types, trials=trials, record=record, no_shear=no_shear,
                      chunk_size=chunk_size, time_chunk=time_chunk, enabled=plan)
 
@@ -271,7 +290,7 @@ def _expand(cond, members, the_plan, block, deterministic, result):
 
 
 def simulate(population, scenes, *, engine="brian2", dt=None, method=None, tolerance=None, trials=1, seed=None,
-             record=RECORD_CHOICES, no_shear="smooth", types=None, plan=True, chunk_size=4096,
+             record=RECORD_CHOICES, no_shear="smooth", types=None, plan=True, chunk_size=None,
              time_chunk=2000, scheduler=None, quiet=False):
     """Simulate a population on one or more scenes.
 
@@ -306,6 +325,8 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
         Skip what provably does not matter (default); False runs everything.
     chunk_size, time_chunk : int
         Afferents and samples per chunk (results do not depend on them).
+        ``chunk_size`` defaults to `default_chunk_size` (512 for the direct
+        engine in process, 4096 for Brian2 or Dask).
     scheduler : None, "processes", distributed.Client or str
         Where the afferent blocks run: in this process (default), a local
         pool of worker processes, a Dask client, or a scheduler address
@@ -335,7 +356,8 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
     scenes = _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_size, time_chunk)
     config = SimConfig(engine, float(dt), method, no_shear, root_seed(seed), int(time_chunk))
     the_plan = plan_run(population, scenes, trials=trials, record=record, no_shear=no_shear, types=types,
-                        chunk_size=chunk_size, time_chunk=time_chunk, plan=plan)
+                        chunk_size=chunk_size, time_chunk=time_chunk, plan=plan, engine=engine,
+                        scheduler=scheduler)
     check_fs(scenes[0].fs, population.current, tuple(np.unique(population.afferent_type[the_plan.selected])))
     spikes = [[] for _ in scenes]
     members = [_unit_members(cond) for cond in the_plan.conditions]
