@@ -19,7 +19,7 @@ silence, the on/off response (hold rate, adaptation, release), and rates below
 500 pulses/s with no spike on consecutive steps on every shipped scene:
 scorecard properties 1-3 (`population.physiology`).
 
-**Fixed, not fitted** (values in the presets, reasons in the README): the
+**Fixed, not fitted** (values in the presets, reasons in docs/model.md): the
 stage structure and time constants; selective and broad share the tuned
 unipolar afferents equally; theta_A ranges; gain spread (CV 0.3); noise;
 FA-II copies FA-I's NAP mix; SA-II's NAP mix, bias and gain.

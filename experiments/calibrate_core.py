@@ -13,7 +13,7 @@ Run::
 
 ``--transducer-scan`` refits the gains for each compressive transducer scale
 ``i_sat`` and cut-off and reports, for each, whether the issue's Table II/III
-checks hold and the peak 10-ms firing rates on both scenes (README "Model").
+checks hold and the peak 10-ms firing rates on both scenes (docs/model.md).
 
 The fitted values are committed as the defaults of `models.CurrentParams`.
 """

@@ -18,7 +18,7 @@ def register(sub) -> None:
     p.add_argument("--population", default="fingertip", help="fingertip, hand or a spec .toml file")
     p.add_argument("--seed", type=int, default=0, help="population and noise seed (default 0)")
     p.add_argument("--properties", default=None, metavar="NAME[,NAME...]",
-                   help="comma-separated property names (default: all; README 'Physiology' lists them)")
+                   help="comma-separated property names (default: all; docs/validation.md lists them)")
     p.add_argument("--engine", choices=("brian2", "direct"), default="direct")
     p.add_argument("--out", metavar="DIR", help="write scorecard.json and one figure per protocol here")
     p.add_argument("--json", action="store_true")

@@ -104,7 +104,7 @@ def run(args) -> int:
         result = compute(config)
     if any(issubclass(w.category, SpikeCapWarning) for w in caught):
         print("note: the paper's linear RA currents drive some afferents at one spike per step on Birznieks' "
-              "32 N/s ramp (README, 'How far we are from the paper')", file=sys.stderr)
+              "32 N/s ramp (docs/model.md, 'How far we are from the paper')", file=sys.stderr)
     if args.json:
         print(json.dumps(result))
     else:

@@ -1,6 +1,6 @@
 """The Brian2 engine: eqs 4-6 in Brian2's C++ standalone mode, compiled once per shape.
 
-Design (measured on this machine kind, see README "Engines"):
+Design (measured on this machine kind, see docs/user-guide.md, "Engines"):
 
 * **Standalone, built once per shape.**  A project is generated for a padded
   shape ``(n_neurons, n_samples)`` plus dt, substeps and method, compiled
@@ -238,10 +238,9 @@ def _build(key: tuple) -> _Build:
 
 
 def _activate(key: tuple) -> _Build:
+    """The build of ``key``: a `_Build` holds only paths and names, so every shape met stays ready."""
     with _LOCK:
         if key not in _BUILDS:
-            _BUILDS.clear()  # release the previous build's Brian2 objects before naming the new one
-            gc.collect()
             _BUILDS[key] = _build(key)
         return _BUILDS[key]
 

@@ -9,7 +9,7 @@ The paper's stage (the default of `CurrentParams`):
 with one causal 20 Hz low-pass before the derivatives (DDMM-NOTES §1.6).
 
 Every departure from it is a named field of `CurrentParams`, off by default,
-which the physiological presets switch on (README "Physiology"):
+which the physiological presets switch on (docs/model.md, "What changed in the model"):
 
 * **Per-type filters.**  ``cutoff_sai_hz`` low-passes SA-I's force;
   ``cutoff_rai_hz`` sets RA-I's low-pass before d/dt (a velocity band-pass,
