@@ -337,7 +337,7 @@ class FusedPlan:
     def __init__(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, params, fs, no_shear, f_th,
                  afferent_id=None, mixing=None):
         afferent_type, nap = np.asarray(afferent_type), np.asarray(nap)
-        self.afferent_type, self._neuron_cache = afferent_type, {}
+        self.afferent_type, self._neuron_cache, self._bounds = afferent_type, {}, {}
         self.mixing = None if mixing is None else np.ascontiguousarray(mixing, dtype=float)
         self.afferent_id = np.ascontiguousarray(np.arange(afferent_type.size) if afferent_id is None else afferent_id,
                                                 dtype=np.int64)
@@ -478,7 +478,9 @@ class FusedPlan:
         ``parts`` > 1 the integration runs on that many column ranges in
         parallel (the spikes are the same, ordered range by range).
         """
-        bounds = part_bounds(v.size, parts)
+        if parts not in self._bounds:
+            self._bounds[parts] = part_bounds(v.size, parts)
+        bounds = self._bounds[parts]
         current = self._drive(forces, state, started, sample0, key, bounds)
         substeps, method, h, half, a, b, c, d, v_peak, v_floor, block = neuron
         serial = bounds.size <= 2

@@ -11,7 +11,6 @@ spike.
 
 from __future__ import annotations
 
-import importlib.util
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -24,7 +23,7 @@ from models.currents import check_fs
 from models.engines import ENGINES, METHODS, prepare, substeps_for
 from models.fused import FusedPlan, mixing_matrix
 
-from ._extras import MissingExtraError
+from ._extras import require
 from .noise import noise_key, root_seed
 from .plan import RECORD_CHOICES, make_plan
 from .sampling import Population
@@ -39,18 +38,18 @@ _PIPELINE = 2  # afferent blocks in flight at once
 #: filter and neuron state then stay in L2 and both threads stay busy to the end (the hand
 #: x 1 s: 0.18 s with 4096, 0.155-0.165 s with 512).  Brian2 and Dask take large ones: each
 #: block is a run of the binary (and a compiled shape) or a task.
-CHUNK_SIZE = {"direct": 512, "other": 4096}
+DIRECT_CHUNK_SIZE, CHUNK_SIZE = 512, 4096
 
 
 def default_chunk_size(engine: str, scheduler=None) -> int:
-    """Afferents per block when ``chunk_size`` is not given (`CHUNK_SIZE`).
+    """Afferents per block when ``chunk_size`` is not given (`DIRECT_CHUNK_SIZE` or `CHUNK_SIZE`).
 
     Examples
     --------
     >>> default_chunk_size("direct"), default_chunk_size("brian2"), default_chunk_size("direct", "processes")
     (512, 4096, 4096)
     """
-    return CHUNK_SIZE["direct" if engine == "direct" and scheduler is None else "other"]
+    return DIRECT_CHUNK_SIZE if engine == "direct" and scheduler is None else CHUNK_SIZE
 
 
 @dataclass(frozen=True)
@@ -375,9 +374,7 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
 def _run_jobs(jobs, config, scheduler, progress) -> list:
     """Results of every job, in order: in this process, or as Dask tasks."""
     if scheduler is not None:
-        if importlib.util.find_spec("distributed") is None:
-            raise MissingExtraError(f"scheduler={scheduler!r} needs Dask's distributed scheduler: "
-                                    'pip install "ddmm[dask]"')
+        require("distributed", f"scheduler={scheduler!r}", "dask")  # the one-line error of a missing extra
         from .distributed import dask_client, run_distributed
 
         with dask_client(scheduler) as client:

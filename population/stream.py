@@ -77,6 +77,12 @@ class Encoder:
         then (n, n_sites, 3), and each afferent feels its own local force
         (`population.spatial`), as `simulate` does for `Scene.from_sites`.
 
+    Notes
+    -----
+    From `PARALLEL_MIN_AFFERENTS` afferents, the direct engine's pushes run
+    on ``DDMM_NUM_THREADS`` numba threads (default: every core), read when
+    the encoder is made; ``DDMM_NUM_THREADS=1`` keeps a push on one core.
+
     Examples
     --------
     >>> from population import make_population
@@ -119,6 +125,8 @@ class Encoder:
         elif self.sites is not None:
             scale = pop.gain * site_coverage(pop, self.sites)
         self._plan = block_plan(pop, self.fs, self.sites, scale, self.no_shear)
+        # Read once: a push is latency-bound, and the thread count is fixed for the encoder's life.
+        self._parts = default_threads() if len(pop) >= PARALLEL_MIN_AFFERENTS else 1
         noisy = np.any(pop.noise_sigma > 0) or np.any(pop.noise_cv > 0)
         self._key = noise_key(self.seed, 0, 0) if noisy else None
 
@@ -175,9 +183,8 @@ class Encoder:
         if n == 0:
             return StreamSpikes(np.empty(0, np.int64), np.empty(0))
         state = self._state.copy()  # committed only if the whole chunk succeeds
-        parts = default_threads() if len(self._order) >= PARALLEL_MIN_AFFERENTS else 1
         afferent, step, neuron = self._plan.advance(forces, state, self._samples, self._key, self._neuron, dt=self.dt,
-                                                    method=self.method, engine=self.engine, parts=parts)
+                                                    method=self.method, engine=self.engine, parts=self._parts)
         step0 = self._samples * self.substeps
         self._state, self._neuron = state, neuron
         self._samples += n

@@ -2,6 +2,7 @@
 
 import os
 import signal
+import sys
 import threading
 import time
 import warnings
@@ -85,9 +86,6 @@ def test_lost_worker_is_retried(client, pop):
 
 
 def test_missing_dask_extra_is_one_line_error(pop, monkeypatch):
-    import importlib.util
-
-    real = importlib.util.find_spec
-    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "distributed" else real(name, *a))
+    monkeypatch.setitem(sys.modules, "distributed", None)  # as if the [dask] extra were not installed
     with pytest.raises(ImportError, match=r'pip install "ddmm\[dask\]"'):
         simulate(pop.select(range(4)), birznieks(90.0), engine="direct", quiet=True, scheduler="processes")
