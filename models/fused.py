@@ -371,10 +371,10 @@ class FusedPlan:
         rad = np.deg2rad(np.asarray(theta_t, dtype=float))
         aff_f[_COS], aff_f[_SIN], aff_f[_K] = np.cos(rad), np.sin(rad), np.asarray(k, dtype=float)
         aff_f[_TIP] = 1.0
-        for j in np.flatnonzero(tuned):
-            profile = get_profile(str(nap[j]))
-            aff_f[_P1:_P5 + 1, j] = [profile.p1, profile.p2, profile.p3, profile.p4, profile.p5]
-            aff_f[_TIP, j] = tip_radius(str(nap[j]))
+        for name in np.unique(nap[tuned]):  # per profile, not per afferent (this runs once per block)
+            profile, rows = get_profile(str(name)), nap == name
+            aff_f[_P1:_P5 + 1, rows] = np.array([profile.p1, profile.p2, profile.p3, profile.p4, profile.p5])[:, None]
+            aff_f[_TIP, rows] = tip_radius(str(name))
         scale = np.asarray(scale, dtype=float)
         for g, ((a, b), (stage, *_)) in enumerate(zip(spans, consts)):
             aff_i[_GROUP, a:b] = g
