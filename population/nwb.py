@@ -19,7 +19,8 @@ Layout (core NWB types only, no extension):
 * **Trials** (``nwbfile.trials``): ``start_time``, ``stop_time`` (s),
   ``condition`` (scene name), ``condition_index`` (position on the Dataset's
   ``condition``), ``trial`` (trial index within the condition), ``theta_r``
-  (deg; 0 when the scene has no nominal shear direction) and ``has_theta_r``.
+  (deg; 0 when the scene has no nominal shear direction), ``has_theta_r`` and
+  ``stages`` (the stage labels with their times in s from the trial's start, as text).
 * **Stages** (``nwbfile.intervals["stages"]``, a TimeIntervals table): one row
   per stage a trial's scene has, ``start_time``/``stop_time`` on the session
   clock, ``stage`` (label, e.g. ``stage2_dynamic``) and ``trial`` (a region of
@@ -175,12 +176,16 @@ def _add_trials(nwbfile, ds, starts, stops) -> None:
                               ("trial", "trial index within the condition (integer)"),
                               ("theta_r", "nominal shear direction theta_R of the scene in degrees; 0 when "
                                           "has_theta_r is False"),
-                              ("has_theta_r", "True when the scene has one nominal shear direction (boolean)")):
+                              ("has_theta_r", "True when the scene has one nominal shear direction (boolean)"),
+                              ("stages", "the scene's stages as 'label start-stop' in s from the trial's start, "
+                                         "separated by '; ' (the same as intervals['stages'])")):
         nwbfile.add_trial_column(name=name, description=description)
     names, theta, has = (ds[n].values for n in ("condition", "theta_r", "has_theta_r"))
     for k, (c, t) in enumerate(zip(cond, trial)):
+        stages = "; ".join(f"{label} {a:g}-{b:g}" for label, a, b in ex.stages_of(ds, c))
         nwbfile.add_trial(start_time=float(starts[k]), stop_time=float(stops[k]), condition=str(names[c]),
-                          condition_index=int(c), trial=int(t), theta_r=float(theta[c]), has_theta_r=bool(has[c]))
+                          condition_index=int(c), trial=int(t), theta_r=float(theta[c]), has_theta_r=bool(has[c]),
+                          stages=stages)
 
 
 def _add_stages(nwbfile, ds, starts) -> None:

@@ -83,6 +83,7 @@ def test_metadata_columns_stages_and_forces(exported):
         assert "deg" in f.units["theta_t"].description and "millimetres" in f.units["x_mm"].description
         trials = f.trials.to_dataframe()
         assert trials.theta_r.tolist() == [90.0, 90.0, 180.0, 180.0] and trials.has_theta_r.all()
+        assert "stage2_dynamic 15-17" in trials.stages.iloc[3].split("; ")  # the stage labels, on the trials table
         stages = f.intervals["stages"].to_dataframe(index=True)
         assert len(stages) == 4 * ds.sizes["stage"]
         row = stages[(stages.trial == 3) & (stages.stage == "stage2_dynamic")].iloc[0]
