@@ -6,7 +6,7 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_write"]
+__all__ = ["atomic_write", "writable_parent"]
 
 
 def _umask_mode() -> int:
@@ -14,6 +14,12 @@ def _umask_mode() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return 0o666 & ~mask
+
+
+def writable_parent(path) -> tuple[Path, bool]:
+    """``(directory of path, whether it exists and can be written)``: the check before an atomic write."""
+    directory = Path(path).parent if str(Path(path).parent) else Path(".")
+    return directory, directory.is_dir() and os.access(directory, os.W_OK)
 
 
 def atomic_write(path, write, *, suffix: str = ".part") -> Path:

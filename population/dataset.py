@@ -27,7 +27,6 @@ Schema (names are fixed):
 from __future__ import annotations
 
 import dataclasses
-import os
 from importlib import metadata
 from pathlib import Path
 
@@ -38,7 +37,7 @@ from models.attenuation import F_TH
 from models.metrics import CONTACT_THRESHOLD
 from models.neuron import NEURON_PARAMS, V_PEAK
 
-from ._files import atomic_write
+from ._files import atomic_write, writable_parent
 from .spatial import RF_SIGMA_MM, RF_SUPPORT
 
 __all__ = ["build_dataset", "save_dataset", "load_dataset", "binned_counts", "binned_rates", "psth",
@@ -213,8 +212,8 @@ def save_dataset(ds: xr.Dataset, path) -> Path:
         If the directory does not exist or cannot be written.
     """
     path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    if not directory.is_dir() or not os.access(directory, os.W_OK):
+    directory, writable = writable_parent(path)
+    if not writable:
         raise ValueError(f"cannot write {str(path)!r}: {str(directory)!r} is not a writable directory")
     return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
 

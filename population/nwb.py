@@ -48,7 +48,7 @@ import numpy as np
 
 from . import _export as ex
 from ._extras import require
-from ._files import atomic_write
+from ._files import atomic_write, writable_parent
 
 __all__ = ["to_nwb"]
 
@@ -119,8 +119,8 @@ def _check_path(path) -> Path:
     path = Path(path)
     if path.suffix != ".nwb":
         raise ValueError(f"to_nwb: path must end in .nwb, got {str(path)!r}")
-    directory = path.parent if str(path.parent) else Path(".")
-    if not directory.is_dir() or not os.access(directory, os.W_OK):
+    directory, writable = writable_parent(path)
+    if not writable:
         raise ValueError(f"to_nwb: cannot write path {str(path)!r}: {str(directory)!r} is not a writable directory")
     if path.is_dir():
         raise ValueError(f"to_nwb: path {str(path)!r} is a directory; allowed: a .nwb file name")
