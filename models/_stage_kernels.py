@@ -23,14 +23,16 @@ def filter_sections(cur, lo, hi, sos, g, n_sections, z):
     ``2s + 1`` of ``z`` (updated).  Sections are the outer loop so that the
     loop over afferents vectorises.
     """
+    c = cur[lo:hi]  # views from 0: loops over range(lo, hi) vectorise worse
     for s in range(n_sections):
         b0, b1, b2, a1, a2 = sos[g, s, 0], sos[g, s, 1], sos[g, s, 2], sos[g, s, 4], sos[g, s, 5]
-        for j in range(lo, hi):
-            x = cur[j]
-            new = b0 * x + z[2 * s, j]
-            z[2 * s, j] = b1 * x - a1 * new + z[2 * s + 1, j]
-            z[2 * s + 1, j] = b2 * x - a2 * new
-            cur[j] = new
+        z0, z1 = z[2 * s, lo:hi], z[2 * s + 1, lo:hi]
+        for j in range(hi - lo):
+            x = c[j]
+            new = b0 * x + z0[j]
+            z0[j] = b1 * x - a1 * new + z1[j]
+            z1[j] = b2 * x - a2 * new
+            c[j] = new
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -47,8 +49,11 @@ def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, t
     (`models.fused`) share, so both give the same bits.
     """
     fs2 = fs * fs
+    # Views from 0: loops over range(lo, hi) vectorise worse.
+    x, offset, y1, y2, slow, gain = x[lo:hi], offset[lo:hi], y1[lo:hi], y2[lo:hi], slow[lo:hi], gain[lo:hi]
+    n = hi - lo
     if order == 0:
-        for j in range(lo, hi):
+        for j in range(n):
             cur = x[j]
             v = cur
             if adapt > 0.0:
@@ -61,31 +66,31 @@ def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, t
             y1[j] = cur
             x[j] = v
     elif order == 1:
-        for j in range(lo, hi):
+        for j in range(n):
             cur = x[j]
             x[j] = (cur - y1[j]) * fs
             y2[j] = y1[j]
             y1[j] = cur
     else:
-        for j in range(lo, hi):
+        for j in range(n):
             cur = x[j]
             x[j] = ((cur - 2.0 * y1[j]) + y2[j]) * fs2
             y2[j] = y1[j]
             y1[j] = cur
     if order > 0 and (adapt > 0.0 or threshold > 0.0):
-        for j in range(lo, hi):
+        for j in range(n):
             a = abs(x[j])
             slow[j] = slow[j] + alpha_adapt * (a - slow[j])
             x[j] = max((a - adapt * slow[j]) - threshold, 0.0)
     if signed:
-        for j in range(lo, hi):
+        for j in range(n):
             x[j] = gain[j] * x[j]
     else:
-        for j in range(lo, hi):
+        for j in range(n):
             x[j] = gain[j] * abs(x[j])
     if noisy:
-        for j in range(lo, hi):
-            x[j] = _noisy(x[j], normals[j, col], cv_scale[j], signed)
+        for j in range(n):
+            x[j] = _noisy(x[j], normals[lo + j, col], cv_scale[lo + j], signed)
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -111,7 +116,8 @@ def receptor_noise_keyed(x, lo, hi, key, afferent_id, sample, cv_scale, signed, 
     else:
         return
     normal_row(key, afferent_id, lo, hi, sample, words, xi)
-    for j in range(lo, hi):
+    x, xi, cv_scale = x[lo:hi], xi[lo:hi], cv_scale[lo:hi]  # views from 0 vectorise better
+    for j in range(hi - lo):
         if x[j] != 0.0 and cv_scale[j] != 0.0:
             x[j] = _noisy(x[j], xi[j], cv_scale[j], signed)
 

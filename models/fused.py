@@ -69,24 +69,33 @@ def _shear(fx, fy, two_fth):
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value, f_th,
-                  opponent):
+                  opponent, af, cached):
     """The drive (newtons) of a group that feels one force, in passes: the profile AF where needed
     (`attenuation.profile_value`), then F_A = AF F_Z under the no-shear reading, or SA-II's stretch
-    (`stretch_drive`).  As one loop, the profile's branches kept the whole body scalar, 3-4x slower."""
+    (`stretch_drive`).  As one loop, the profile's branches kept the whole body scalar, 3-4x slower.
+
+    AF depends on the shear direction alone, so ``af[lo:hi]`` keeps the last
+    values computed; with ``cached`` (same ``ux``, ``uy`` as then) they are
+    reused: the same bits, and a fixed-direction ramp or hold costs no
+    profile evaluations after its first sample.
+    """
     if tuned and mag > 0.0 and (smooth_reading or stretch or mag > f_th):
-        for j in range(lo, hi):
-            f[j] = profile_value(ux, uy, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j], aff_f[_P1, j], aff_f[_P2, j],
-                                 aff_f[_P3, j], aff_f[_P4, j], aff_f[_P5, j], aff_f[_TIP, j])
+        if not cached:
+            for j in range(lo, hi):
+                af[j] = profile_value(ux, uy, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j], aff_f[_P1, j],
+                                      aff_f[_P2, j], aff_f[_P3, j], aff_f[_P4, j], aff_f[_P5, j], aff_f[_TIP, j])
+        f[lo:hi] = af[lo:hi]
     else:
         f[lo:hi] = 1.0
+    f = f[lo:hi]  # a view from 0: loops over range(lo, hi) vectorise worse
     if stretch:
-        for j in range(lo, hi):
+        for j in range(f.size):
             f[j] = mag * (f[j] - opponent * (1.0 - f[j]))
     elif smooth_reading:
-        for j in range(lo, hi):
+        for j in range(f.size):
             f[j] = (((f[j] - 1.0) * w) + 1.0) * fz
     else:
-        for j in range(lo, hi):
+        for j in range(f.size):
             f[j] = (f[j] if mag > f_th else outside_value) * fz
 
 
@@ -196,9 +205,10 @@ def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, st
     n, m, rows = out.shape[0], aff_i.shape[1], 2 * sos.shape[1]
     z, offset = state[:rows], state[rows + _OFFSET]
     y1, y2, slow = state[rows + _Y1], state[rows + _Y2], state[rows + _SLOW]
-    f, words, xi = np.empty(m), np.empty(m, np.uint64), np.empty(m)
+    f, words, xi, af = np.empty(m), np.empty(m, np.uint64), np.empty(m), np.empty(m)
     mags, wts, local = np.empty(m), np.empty(m), np.empty((3, m))
     gain, cv_scale, two_fth = aff_f[_GAIN], aff_f[_CV], 2.0 * f_th
+    af_ux, af_uy = np.full(grp_i.shape[1], np.nan), np.full(grp_i.shape[1], np.nan)  # direction of each group's af
     for i in range(n):
         fz, mag, ux, uy, w = 0.0, 0.0, 0.0, 0.0, 0.0
         if mixed:
@@ -217,12 +227,15 @@ def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, st
             elif not tuned and not stretch:
                 f[lo:hi] = fz  # untuned pressure afferents: F_A = F_Z
             else:
+                profiled = tuned and mag > 0.0 and (smooth_reading or stretch or mag > f_th)
+                cached = profiled and ux == af_ux[g] and uy == af_uy[g]
                 _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value,
-                              f_th, opponent)
+                              f_th, opponent, af, cached)
+                if profiled:
+                    af_ux[g], af_uy[g] = ux, uy
             if i == 0 and not started and grp_i[_PLAIN, g] == 0:
                 offset[lo:hi] = f[lo:hi]  # `initial_filter_state`: at rest on the first sample
-            for j in range(lo, hi):
-                f[j] = f[j] - offset[j]
+            f[lo:hi] -= offset[lo:hi]
             filter_sections(f, lo, hi, sos, g, grp_i[_NSEC, g], z)
             stage_tail(f, lo, hi, offset, y1, y2, slow, fs, grp_i[_ORDER, g], grp_f[_ADAPT, g],
                        grp_f[_ALPHA_ADAPT, g], grp_f[_THRESHOLD, g], gain, _NO_NORMALS, i, cv_scale, False,
@@ -245,14 +258,17 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f
     sub_ids = ids[sigma_idx]
     words, xi = np.empty(sigma_idx.size, np.uint64), np.empty(sigma_idx.size)
     for i in range(current.shape[0]):
-        for j in range(current.shape[1]):
-            g, x = aff_i[_GROUP, j], current[i, j]
+        for g in range(grp_i.shape[1]):  # groups outside, views from 0: the loops vectorise
+            lo, hi = grp_i[_START, g], grp_i[_STOP, g]
+            x, alpha, bias = current[i, lo:hi], grp_f[_ALPHA_SMOOTH, g], grp_f[_BIAS, g]
             if grp_i[_SMOOTHED, g] != 0:
-                smooth[j] = smooth[j] + grp_f[_ALPHA_SMOOTH, g] * (x - smooth[j])  # `smooth_kernel`
-                x = smooth[j]
-            if grp_f[_BIAS, g] != 0.0:
-                x = x + grp_f[_BIAS, g]
-            current[i, j] = x
+                c = smooth[lo:hi]
+                for j in range(hi - lo):
+                    c[j] = c[j] + alpha * (x[j] - c[j])  # `smooth_kernel`
+                    x[j] = c[j]
+            if bias != 0.0:
+                for j in range(hi - lo):
+                    x[j] = x[j] + bias
         if additive and sigma_idx.size:
             normal_row(key, sub_ids, 0, sub_ids.size, sample0 + i, words, xi)
             for k in range(sigma_idx.size):

@@ -102,18 +102,20 @@ def normal_row(key, afferent_id, lo, hi, sample, words, out):
     """
     k0, k1 = np.uint64(key) & _MASK32, np.uint64(key) >> np.uint64(32)
     c0 = np.uint64(sample) & _MASK32
-    for j in range(lo, hi):
-        aid = np.uint64(afferent_id[j])
+    # Views from 0: loops over range(lo, hi) vectorised 2-5x worse (2 -> 4-10 ns a draw).
+    ids, words, out, n = afferent_id[lo:hi], words[lo:hi], out[lo:hi], hi - lo
+    for j in range(n):
+        aid = np.uint64(ids[j])
         a, b, _, _ = philox4x32(c0, aid & _MASK32, aid >> np.uint64(32), np.uint64(0), k0, k1)
         words[j] = (a << np.uint64(32)) | b
-    for j in range(lo, hi):
+    for j in range(n):
         word = words[j]
         z = _uniform52(word) * _X[word & np.uint64(0xFF)]
         out[j] = -z if (word >> np.uint64(8)) & np.uint64(1) else z
-    for j in range(lo, hi):
+    for j in range(n):
         word = words[j]
         if abs(out[j]) >= _X[(word & np.uint64(0xFF)) + np.uint64(1)]:
-            aid = np.uint64(afferent_id[j])
+            aid = np.uint64(ids[j])
             out[j] = _slow_normal(k0, k1, c0, aid & _MASK32, aid >> np.uint64(32), word, _X, _F, _R)
 
 

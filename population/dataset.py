@@ -27,9 +27,11 @@ Schema (names are fixed):
 from __future__ import annotations
 
 import dataclasses
+import functools
 from importlib import metadata
 from pathlib import Path
 
+import numba as nb
 import numpy as np
 import xarray as xr
 
@@ -44,6 +46,7 @@ __all__ = ["build_dataset", "save_dataset", "load_dataset", "binned_counts", "bi
            "describe_dataset"]
 
 
+@functools.lru_cache(maxsize=1)
 def _version() -> str:
     try:
         return metadata.version("ddmm")
@@ -122,8 +125,9 @@ def _condition_coords(scenes) -> dict:
     }
 
 
-def _events(plan, spikes):
-    """Concatenate per-condition spikes, keep requested afferents, sort: (condition, trial, step, afferent)."""
+def _events(plan, spikes, n_conditions: int):
+    """Concatenate per-condition spikes, keep requested afferents, sort by (condition, trial, step,
+    afferent): the four event arrays and the spike counts per (condition, trial, afferent)."""
     remap = np.full(plan.selected.size, -1, np.int64)
     remap[plan.keep] = np.arange(plan.keep.size)
     cols = [[], [], [], []]
@@ -134,17 +138,61 @@ def _events(plan, spikes):
             for col, arr in zip(cols, (np.full(ok.sum(), c), trial[ok], step[ok], aff[ok])):
                 col.append(np.asarray(arr, np.int64))
     cond, trial, step, aff = (np.concatenate(c) if c else np.empty(0, np.int64) for c in cols)
-    return _sorted_events(cond, trial, step, aff, plan.trials, plan.keep.size)
+    return _sorted_events(cond, trial, step, aff, n_conditions, plan.trials, plan.keep.size)
 
 
-def _sorted_events(cond, trial, step, aff, n_trials: int, n_afferents: int):
-    """The events sorted by condition, trial, step and afferent (one sort of a packed key when it fits)."""
-    n_steps = int(step.max()) + 1 if step.size else 1
-    if (int(cond.max()) + 1 if cond.size else 1) * n_trials * n_steps * n_afferents < 2**62:
+def _sorted_events(cond, trial, step, aff, n_conditions: int, n_trials: int, n_afferents: int):
+    """The events sorted by condition, trial, step and afferent, and the counts (n_conditions, n_trials,
+    n_afferents).
+
+    Two counting-sort passes (by afferent, then stably by time) when the
+    time slots are few against the events, as in any run with many spikes;
+    else one sort of a packed key, or lexsort when that key could overflow.
+    """
+    n_units, n_steps = n_conditions * n_trials * n_afferents, int(step.max()) + 1 if step.size else 1
+    n_slots = n_conditions * n_trials * n_steps
+    if n_slots <= max(4 * cond.size, 2**20):
+        cond, trial, step, aff, counts = _counting_sort(cond, trial, step, aff, n_trials, n_steps, n_afferents,
+                                                        n_units, n_slots)
+        return cond, trial, step, aff, counts.reshape(n_conditions, n_trials, n_afferents)
+    if n_slots * n_afferents < 2**62:
         order = np.argsort(_packed(_packed(_packed(cond, trial, n_trials), step, n_steps), aff, n_afferents))
     else:  # a packed key would overflow int64
         order = np.lexsort((aff, step, trial, cond))
-    return cond[order], trial[order], step[order], aff[order]
+    cond, trial, step, aff = cond[order], trial[order], step[order], aff[order]
+    counts = np.bincount(_packed(_packed(cond, trial, n_trials), aff, n_afferents), minlength=n_units)
+    return cond, trial, step, aff, counts.reshape(n_conditions, n_trials, n_afferents)
+
+
+@nb.njit(cache=True, nogil=True)
+def _counting_sort(cond, trial, step, aff, n_trials, n_steps, n_afferents, n_units, n_slots):
+    """`_sorted_events`' counting sorts: by (condition, trial, afferent), whose histogram is the spike
+    counts, then stably by (condition, trial, step), which keeps afferents ascending within a step."""
+    n = cond.size
+    unit, counts = np.empty(n, np.int64), np.zeros(n_units, np.int64)
+    for e in range(n):
+        unit[e] = (cond[e] * n_trials + trial[e]) * n_afferents + aff[e]
+        counts[unit[e]] += 1
+    by_unit = _scatter(unit, counts, np.arange(n))
+    slot = np.empty(n, np.int64)
+    for e in range(n):
+        slot[e] = (cond[e] * n_trials + trial[e]) * n_steps + step[e]
+    order = _scatter(slot[by_unit], np.bincount(slot, minlength=n_slots), by_unit)
+    return cond[order], trial[order], step[order], aff[order], counts
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _scatter(key, histogram, values):
+    """``values`` placed stably in the order of ``key`` (whose per-key counts are ``histogram``)."""
+    start, total = np.empty(histogram.size, np.int64), 0
+    for k in range(histogram.size):
+        start[k] = total
+        total += histogram[k]
+    out = np.empty(values.size, np.int64)
+    for e in range(values.size):
+        out[start[key[e]]] = values[e]
+        start[key[e]] += 1
+    return out
 
 
 def _packed(high, low, n_low: int) -> np.ndarray:
@@ -156,11 +204,10 @@ def _packed(high, low, n_low: int) -> np.ndarray:
 
 def build_dataset(population, scenes, plan, spikes, config) -> xr.Dataset:
     """Assemble the Dataset of a run (schema in the module docstring)."""
-    cond, trial, step, aff = _events(plan, spikes)
+    n_c, n_t = len(scenes), plan.trials
+    cond, trial, step, aff, counts = _events(plan, spikes, n_c)
     time = step * config.dt
-    n_c, n_t, n_a = len(scenes), plan.trials, plan.keep.size
-    counts = np.bincount(_packed(_packed(cond, trial, n_t), aff, n_a), minlength=n_c * n_t * n_a).astype(np.int32)
-    counts = counts.reshape(n_c, n_t, n_a)
+    counts = counts.astype(np.int32)
     data = {"spike_count": xr.Variable(("condition", "trial", "afferent"), counts, {"units": "1"})}
     if "spikes" in plan.record:
         data["spike_time"] = xr.Variable("spike", time, {"units": "s"})

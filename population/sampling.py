@@ -98,9 +98,24 @@ class Population:
         return len(self.afferent_type)
 
     def select(self, index) -> "Population":
-        """The afferents at ``index`` (indices or a boolean mask); ids are kept."""
-        kwargs = {name: getattr(self, name)[index] for name in _ARRAYS}
-        return Population(**kwargs, current=self.current, name=self.name)
+        """The afferents at ``index`` (indices or a boolean mask); ids are kept.
+
+        The values were validated when this population was made, so only
+        the ids' uniqueness is checked again (an index may repeat).
+        """
+        arrays = {name: getattr(self, name)[index] for name in _ARRAYS}
+        if arrays["afferent_id"].ndim != 1:
+            raise ValueError(f"index must select a 1-d set of afferents (indices, a slice or a mask), got {index!r}")
+        idx = np.asarray(index) if not isinstance(index, slice) else np.empty(0, np.int64)
+        if idx.dtype != bool and idx.size and np.bincount(idx.ravel() % len(self), minlength=len(self)).max() > 1:
+            raise ValueError("population afferent_id values must be unique: index repeats an afferent")
+        sub = object.__new__(Population)  # a simulation selects every block: skip the per-element checks
+        for name, arr in arrays.items():
+            arr.setflags(write=False)
+            object.__setattr__(sub, name, arr)
+        object.__setattr__(sub, "current", self.current)
+        object.__setattr__(sub, "name", self.name)
+        return sub
 
     def counts(self) -> dict:
         """Afferents per type."""
@@ -114,7 +129,7 @@ def _validate_values(pop: Population) -> None:
     bad = sorted(set(pop.nap.tolist()) - set(NAP_CHOICES))
     if bad:
         raise ValueError(f"nap={bad[0]!r} is unknown; allowed: {', '.join(NAP_CHOICES)}")
-    if not all(isinstance(r, str) for r in pop.region.tolist()):
+    if not all(issubclass(t, str) for t in set(map(type, pop.region.tolist()))):  # per type: C-speed
         bad = next(r for r in pop.region.tolist() if not isinstance(r, str))
         raise ValueError(f"population region must hold strings ('' when unknown), got {bad!r}")
     for name in ("theta_t", "gain", "x_mm", "y_mm", "noise_sigma", "noise_cv", "k", "frame_deg"):

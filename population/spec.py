@@ -41,6 +41,7 @@ TOML layout (every table optional unless marked)::
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -445,6 +446,13 @@ def spec_from_dict(data: dict, *, default_name: str = "custom") -> PopulationSpe
     })
 
 
+@functools.lru_cache(maxsize=None)
+def _preset(name: str) -> PopulationSpec:
+    """A packaged preset, parsed once per process (a spec is frozen, so sharing it is safe)."""
+    text = resources.files("population").joinpath("presets", f"{name}.toml").read_text()
+    return spec_from_dict(tomllib.loads(text), default_name=name)
+
+
 def load_spec(source) -> PopulationSpec:
     """Load a preset by name (``"fingertip"``, ``"hand"``) or a spec from a TOML path.
 
@@ -461,8 +469,8 @@ def load_spec(source) -> PopulationSpec:
     if isinstance(source, PopulationSpec):
         return source
     if isinstance(source, str) and source in PRESETS:
-        text = resources.files("population").joinpath("presets", f"{source}.toml").read_text()
-        name = source
+        spec = _preset(source)
+        return dataclasses.replace(spec, types=dict(spec.types))  # its own dict: the cached one stays as read
     else:
         path = Path(source)
         if path.suffix != ".toml":

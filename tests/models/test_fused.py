@@ -74,6 +74,32 @@ def test_fused_currents_equal_the_stage_by_stage_path(seed, no_shear, physio, no
     np.testing.assert_array_equal(np.concatenate(parts), expected)
 
 
+def held_forces(seed, n=400):
+    """Shear held in a few directions: above F_TH at A, below it while turning to B, above it at B, back to A.
+
+    The fused path reuses AF while the direction stays the same; this is the
+    case where a stale reuse would show (a group that skipped the profile
+    below F_TH must not take another group's values at B).
+    """
+    rng = np.random.default_rng(seed)
+    a, b = rng.uniform(0, 2 * np.pi, 2)
+    angle = np.repeat([a, b, b, a], n // 4)
+    shear = np.repeat([0.3, 0.05, 0.3, 0.3], n // 4)
+    fz = np.full(n, 2.0) + 0.01 * rng.standard_normal(n)
+    return np.column_stack([shear * np.cos(angle), shear * np.sin(angle), fz])
+
+
+@pytest.mark.parametrize("no_shear", ["pass", "block", "smooth"])
+def test_fused_currents_equal_the_reference_on_held_directions(no_shear):
+    rng = np.random.default_rng(7)
+    n = len(TYPES)
+    theta, k, scale = rng.uniform(0, 360, n), rng.uniform(2.0, 5.0, n), np.ones(n)
+    f = held_forces(3)
+    expected = reference(f, PHYSIO, no_shear, scale, np.zeros(n), np.zeros(n), theta, k, None)
+    plan = FusedPlan(TYPES, NAPS, theta, k, scale, np.zeros(n), np.zeros(n), PHYSIO, FS, no_shear, 0.1)
+    np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False), expected)
+
+
 def test_fused_plan_needs_no_tuned_afferent():
     plan = FusedPlan(["RAI", "RAI"], ["none", "none"], [0.0, 0.0], [3.0, 3.0], [1.0, 1.0], [0.0, 0.0], [0.0, 0.0],
                      PHYSIO, FS, "smooth", 0.1)

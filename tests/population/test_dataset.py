@@ -42,17 +42,23 @@ def test_rates_need_events(ds):
         binned_counts(ds.drop_vars("spike_time"), 0.1)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(st.lists(st.tuples(st.integers(0, 3), st.integers(0, 2), st.integers(0, 10**6), st.integers(0, 50)),
                 max_size=60, unique=True),
-       st.sampled_from([10**6 + 1, 10**17]))
+       st.sampled_from([5, 10**6 + 1, 10**17]))
 def test_events_sort_like_lexsort(events, n_steps_bound):
-    """The packed-key sort (and its lexsort fallback when the key would overflow) orders like lexsort."""
+    """Each path of the event sort (counting sorts for few time slots, the packed key, lexsort when the key
+    would overflow) orders like lexsort and counts like bincount."""
     from population.dataset import _sorted_events
 
     cond, trial, step, aff = (np.array([e[i] for e in events], np.int64) for i in range(4))
+    step %= n_steps_bound
     if step.size:
-        step[0] = n_steps_bound - 1  # sets n_steps: 10**17 forces the fallback
+        step[0] = n_steps_bound - 1  # sets n_steps: 5 takes the counting sorts, 10**17 the lexsort
+    keep = np.sort(np.unique(np.column_stack([cond, trial, step, aff]), axis=0, return_index=True)[1])
+    cond, trial, step, aff = cond[keep], trial[keep], step[keep], aff[keep]
     order = np.lexsort((aff, step, trial, cond))
-    for got, want in zip(_sorted_events(cond, trial, step, aff, 3, 51), (cond, trial, step, aff)):
-        np.testing.assert_array_equal(got, want[order])
+    *got, counts = _sorted_events(cond, trial, step, aff, 4, 3, 51)
+    for g, want in zip(got, (cond, trial, step, aff)):
+        np.testing.assert_array_equal(g, want[order])
+    np.testing.assert_array_equal(counts.ravel(), np.bincount((cond * 3 + trial) * 51 + aff, minlength=4 * 3 * 51))
