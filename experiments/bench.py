@@ -2,8 +2,9 @@
 
 Every case runs in a fresh Python process, so peak RSS is the case's own.
 In-process cases do one untimed warm-up run first (the Brian2 build for the
-shape and the numba kernels are cached on disk after it), then time the
-pipeline spec -> forces -> spikes -> Dataset.  The cold-start case times a
+shape and the numba kernels are cached on disk after it), then report the
+median of three timed runs of the pipeline spec -> forces -> spikes ->
+Dataset (the integration kernel alone is timed the same way).  The cold-start case times a
 fresh ``ddmm simulate`` process writing a file, after a first process has
 filled the caches; that first process's extra time is reported separately
 as the one-time compile.
@@ -55,35 +56,53 @@ def _pipeline(population: str, engine: str, sim_s: float):
     return len(pop), ds
 
 
+#: Timed runs of a warm case; its wall time is their median (the host is shared and noisy).
+REPEATS = 3
+
+
+def _median_wall(run, repeats: int = REPEATS):
+    """(median wall time in s of ``repeats`` calls of ``run``, the last call's result)."""
+    import statistics
+
+    walls = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        out = run()
+        walls.append(time.perf_counter() - start)
+    return statistics.median(walls), out
+
+
 def run_case(name: str) -> dict:
-    """Run one case in this process and return its measurements."""
+    """Run one case in this process and return its measurements.
+
+    A warm case: one untimed run, then the median of `REPEATS` timed runs.
+    A cold case (hand x 10 s, for its peak memory): one timed run.
+    """
     population, engine, sim_s, warm = CASES[name]
     if warm:
         _pipeline(population, engine, sim_s)
-    start = time.perf_counter()
-    n, ds = _pipeline(population, engine, sim_s)
-    wall = time.perf_counter() - start
+    wall, (n, ds) = _median_wall(lambda: _pipeline(population, engine, sim_s), REPEATS if warm else 1)
     result = {"name": name, "engine": engine, "n_afferents": n, "sim_s": sim_s, "dt_ms": DT * 1e3,
               "wall_s": round(wall, 4), "afferent_s_per_wall_s": round(n * sim_s / wall, 1),
               "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
-              "spikes": int(ds.sizes["spike"])}
+              "spikes": int(ds.sizes["spike"]), "timed_runs": REPEATS if warm else 1}
     if name == "hand_1s_direct":
         result["kernel_s"] = _kernel_alone(n, sim_s)
     return result
 
 
 def _kernel_alone(n: int, sim_s: float) -> float:
-    """The direct engine's integration alone (all threads) on a constant 5 mV/ms for n neurons x sim_s, in s."""
+    """The direct engine's integration alone (all threads) on a constant 5 mV/ms for n neurons x sim_s, in s:
+    timed as the pipeline (one full-size warm-up, the median of `REPEATS` runs)."""
     import numpy as np
 
     from models.engines import integrate
 
     current = np.full((int(sim_s * 1000), n), 5.0)
     types = np.array(["RAI"] * n)
-    integrate(current[:10], fs=1000.0, dt=DT, afferent_type=types, engine="direct")  # warm-up
-    start = time.perf_counter()
-    integrate(current, fs=1000.0, dt=DT, afferent_type=types, engine="direct")
-    return round(time.perf_counter() - start, 4)
+    run = lambda: integrate(current, fs=1000.0, dt=DT, afferent_type=types, engine="direct")  # noqa: E731
+    run()  # warm-up: kernels, thread pool, spike buffers
+    return round(_median_wall(run)[0], 4)
 
 
 def _population_100k():

@@ -24,6 +24,7 @@ loop over a block vectorises; blocks are shared between threads (numba
 
 from __future__ import annotations
 
+import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 
@@ -141,6 +142,25 @@ def _block(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor
                     stp[n] = step
                     n += 1
     return n_samples, n
+
+
+@nb.njit(cache=True, nogil=True)
+def spike_checks(idx, stp, v, u):
+    """(finite, capped, ordered): whether ``v`` and ``u`` are finite, whether a neuron spiked on
+    consecutive steps, and whether each neuron's spikes came in time order (both engines give
+    them so; when not, ``capped`` means nothing and the caller sorts)."""
+    finite = True
+    for j in range(v.size):
+        if not (math.isfinite(v[j]) and math.isfinite(u[j])):
+            finite = False
+    last, capped, ordered = np.full(v.size, -2, np.int64), False, True
+    for k in range(idx.size):
+        if stp[k] == last[idx[k]] + 1:
+            capped = True
+        elif stp[k] <= last[idx[k]]:
+            ordered = False
+        last[idx[k]] = stp[k]
+    return finite, capped, ordered
 
 
 @nb.njit(cache=True, nogil=True)

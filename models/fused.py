@@ -36,7 +36,7 @@ import numpy as np
 from ._stage_kernels import filter_sections, receptor_noise_keyed, stage_tail, transduce_inplace
 from .attenuation import UNTUNED, profile_value
 from .currents import _stage_constants
-from .direct import _BLOCK, _METHOD_CODES, _integrate_range, integrate_parts, part_bounds
+from .direct import _BLOCK, _METHOD_CODES, _integrate_range, integrate_parts, part_bounds, spike_checks
 from .engines import NeuronState, check_integration, check_stability, integrate, substeps_for
 from .nap import get_profile, tip_radius
 from .neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
@@ -54,6 +54,7 @@ _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = ran
 # Rows of the state after the 2 * n_sections filter rows.
 _OFFSET, _Y1, _Y2, _SLOW, _SMOOTH = range(5)
 
+_RANGE = 512  # afferents per range of the front pass: its state and scratch fit in cache
 _NO_NORMALS = np.zeros((0, 1)).T  # same layout as a transposed noise block
 _NO_FORCES, _NO_SITES, _NO_WEIGHTS = np.zeros((0, 3)), np.zeros((0, 0, 3)), np.zeros((0, 0))
 
@@ -172,10 +173,18 @@ def mix_forces(forces, weights):
 @nb.njit(cache=True, nogil=True)
 def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f, grp_i,
            sos, fs, smooth_reading, outside_value, f_th, opponent):
-    """Force to linear drive (n, n_afferents); ``state`` updated in place (`_front_range` on every afferent)."""
+    """Force to linear drive (n, n_afferents); ``state`` updated in place (`_front_range` on every afferent).
+
+    Afferents go in ranges of `_RANGE`, whose state and scratch stay in
+    cache over all samples (one range of Brian2's 4096-wide blocks cost
+    about twice as much per afferent-sample).
+    """
     out = np.empty((forces.shape[0] if not mixed else sites.shape[0], aff_i.shape[1]))
-    _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f,
-                 grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, 0, aff_i.shape[1])
+    m = aff_i.shape[1]
+    for a0 in range(0, m, _RANGE):
+        _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i,
+                     grp_f, grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, a0,
+                     min(m, a0 + _RANGE))
     return out
 
 
@@ -293,23 +302,8 @@ def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f
         return np.empty(0, np.int64), np.empty(0, np.int64), lowest, True, False
     idx, stp = _integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, 0,
                                 v.size)
-    finite, capped = _spike_checks(idx, stp, v, u)
+    finite, capped, _ = spike_checks(idx, stp, v, u)
     return idx, stp, lowest, finite, capped
-
-
-@nb.njit(cache=True, nogil=True)
-def _spike_checks(idx, stp, v, u):
-    """Whether the state stayed finite, and whether a neuron spiked on consecutive steps."""
-    finite = True
-    for j in range(v.size):
-        if not (math.isfinite(v[j]) and math.isfinite(u[j])):
-            finite = False
-    last, capped = np.full(v.size, -2, np.int64), False
-    for k in range(idx.size):  # spikes come neuron block by block, in time within a block
-        if stp[k] == last[idx[k]] + 1:
-            capped = True
-        last[idx[k]] = stp[k]
-    return finite, capped
 
 
 class FusedPlan:
@@ -507,5 +501,5 @@ class FusedPlan:
         if not serial:  # from Python, as the front's parallel kernel
             idx, stp = integrate_parts(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
                                        bounds)
-            out = (idx, stp, out[2], *_spike_checks(idx, stp, v, u))
+            out = (idx, stp, out[2], *spike_checks(idx, stp, v, u)[:2])
         return (current, *out)

@@ -24,6 +24,22 @@ def test_strong_input_at_1ms_is_finite_and_warns_when_capped(engine):
     assert res.counts(3).max() <= 200
 
 
+@pytest.mark.parametrize("order", ["by_time", "by_neuron_descending_time"])
+def test_cap_check_finds_consecutive_spikes_in_any_order(order):
+    """`check_integration` scans in one pass when each neuron's spikes come in time order, and sorts when not."""
+    from models.engines import check_integration
+
+    neuron, step = np.array([0, 1, 1, 2]), np.array([3, 7, 8, 20])
+    if order != "by_time":
+        neuron, step = neuron[::-1], step[::-1]
+    state = np.zeros(3)
+    with pytest.warns(SpikeCapWarning, match="1 neuron"):
+        check_integration(neuron, step, state, state, np.zeros((1, 3)), "euler", 1e-4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SpikeCapWarning)
+        check_integration(neuron[:2], step[:2], state, state, np.zeros((1, 3)), "euler", 1e-4)
+
+
 @pytest.mark.parametrize("engine", ENGINES)
 def test_moderate_input_does_not_warn(engine):
     with warnings.catch_warnings():
