@@ -11,6 +11,8 @@ spike.
 
 from __future__ import annotations
 
+import dataclasses
+
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -170,7 +172,27 @@ def population_currents(population, scene, *, no_shear: str = "smooth") -> np.nd
 
 
 def run_chunk(job: ChunkJob, config: SimConfig, progress=None):
-    """Simulate one block; returns (trial, afferent index within the block, step) arrays."""
+    """Simulate one block; returns (trial, afferent index within the block, step) arrays.
+
+    The direct engine takes a large block (a Dask task's 4096) in parts of
+    `DIRECT_CHUNK_SIZE`, whose state stays in cache: as one part, the 100k
+    case on 2 workers took 1.6 s against 0.93 s in process.
+    """
+    n = len(job.population)
+    if config.engine != "direct" or n <= DIRECT_CHUNK_SIZE:
+        return _run_block(job, config, progress)
+    out = [[], [], []]
+    for lo in range(0, n, DIRECT_CHUNK_SIZE):
+        sl = slice(lo, min(n, lo + DIRECT_CHUNK_SIZE))
+        part = dataclasses.replace(job, population=job.population.select(sl),
+                                   weights=None if job.weights is None else job.weights[sl])
+        trial, afferent, step = _run_block(part, config, progress)
+        for col, arr in zip(out, (trial, afferent + lo, step)):
+            col.append(arr)
+    return tuple(np.concatenate(col) for col in out)
+
+
+def _run_block(job: ChunkJob, config: SimConfig, progress=None):
     pop, scene = job.population, job.scene
     scale = pop.gain if job.weights is None else pop.gain * job.weights
     plan = block_plan(pop, scene.fs, scene.sites, scale, config.no_shear)  # once for every trial

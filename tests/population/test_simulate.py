@@ -121,6 +121,16 @@ def test_chunking_does_not_change_results(small):
         assert ds.identical(ref)
 
 
+def test_large_direct_blocks_run_in_parts_with_the_same_results(fingertip):
+    """A block above DIRECT_CHUNK_SIZE (a Dask task's 4096) runs in parts: receptive-field weights,
+    trials and time chunks must follow each part."""
+    scene = birznieks(90.0, contact=Contact(0.0, 0.0, 4.0))
+    ref = simulate(fingertip, scene, engine="direct", seed=3, trials=2, quiet=True)
+    big = simulate(fingertip, scene, engine="direct", seed=3, trials=2, quiet=True, chunk_size=4096, time_chunk=333)
+    assert ref.sizes["spike"] > 1000
+    assert big.identical(ref)
+
+
 def test_seeds(small):
     a, b, c = (simulate(small, birznieks(90.0), engine="direct", seed=s, quiet=True) for s in (1, 1, 2))
     assert a.identical(b)
