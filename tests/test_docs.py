@@ -76,11 +76,11 @@ def test_reference_pages_match_the_code(name):
 
 
 def test_figures_exist_and_name_their_command():
-    for page in DOCS.glob("*.md"):
+    for page in [ROOT / "README.md", *DOCS.glob("*.md")]:
         lines = page.read_text().splitlines()
         for i, line in enumerate(lines):
             for figure in re.findall(r"!\[[^\]]*\]\(([^)]+\.png)\)", line):
-                assert (DOCS / figure).exists(), f"{page.name}: {figure} is missing"
+                assert (page.parent / figure).exists(), f"{page.name}: {figure} is missing"
                 caption = " ".join(lines[i + 1:i + 4])
                 assert re.search(r"made by `ddmm [^`]*--out", caption), (
                     f"{page.name}: {figure} does not name the `ddmm ... --out` command that makes it")
