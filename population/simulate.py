@@ -11,11 +11,9 @@ spike.
 
 from __future__ import annotations
 
-import dataclasses
-
 import sys
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -184,8 +182,8 @@ def run_chunk(job: ChunkJob, config: SimConfig, progress=None):
     out = [[], [], []]
     for lo in range(0, n, DIRECT_CHUNK_SIZE):
         sl = slice(lo, min(n, lo + DIRECT_CHUNK_SIZE))
-        part = dataclasses.replace(job, population=job.population.select(sl),
-                                   weights=None if job.weights is None else job.weights[sl])
+        part = replace(job, population=job.population.select(sl),
+                       weights=None if job.weights is None else job.weights[sl])
         trial, afferent, step = _run_block(part, config, progress)
         for col, arr in zip(out, (trial, afferent + lo, step)):
             col.append(arr)

@@ -58,6 +58,11 @@ def test_select_keeps_ids_and_make_population_validates():
     pop = sample_population("fingertip", rng=0)
     sub = pop.select(np.array([5, 700]))
     np.testing.assert_array_equal(sub.afferent_id, [5, 700])
+    assert not sub.k.flags.writeable and len(pop.select(slice(10, 20))) == 10
+    assert len(pop.select(pop.afferent_type == "SAII")) == 36
+    for repeated in ([3, 3], [0, -len(pop)]):  # select skips the element checks, not this one
+        with pytest.raises(ValueError, match="repeats an afferent"):
+            pop.select(repeated)
     with pytest.raises(ValueError, match="k="):
         make_population(["SAI"], nap="broad", k=1.0)
     with pytest.raises(ValueError, match="afferent_type"):

@@ -82,3 +82,12 @@ def test_bad_files(tmp_path):
     bad.write_text("[types.SAI\ncount = 3")
     with pytest.raises(ValueError, match="not valid TOML"):
         load_spec(bad)
+
+
+def test_presets_are_parsed_once_but_handed_out_as_copies():
+    """`load_spec` caches each preset; a caller that edits its spec's dicts must not change the next load."""
+    first = load_spec("hand")
+    first.types["SAI"].nap["broad"] = 0.99
+    first.types.clear()
+    again = load_spec("hand")
+    assert len(again.types) == 4 and again.types["SAI"].nap["broad"] != 0.99
