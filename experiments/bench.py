@@ -100,7 +100,9 @@ def _kernel_alone(n: int, sim_s: float) -> float:
 
     current = np.full((int(sim_s * 1000), n), 5.0)
     types = np.array(["RAI"] * n)
-    run = lambda: integrate(current, fs=1000.0, dt=DT, afferent_type=types, engine="direct")  # noqa: E731
+    def run():
+        return integrate(current, fs=1000.0, dt=DT, afferent_type=types, engine="direct")
+
     run()  # warm-up: kernels, thread pool, spike buffers
     return round(_median_wall(run)[0], 4)
 

@@ -145,21 +145,28 @@ def _block(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor
 
 
 @nb.njit(cache=True, nogil=True)
-def spike_checks(idx, stp, v, u):
-    """(finite, capped, ordered): whether ``v`` and ``u`` are finite, whether a neuron spiked on
-    consecutive steps, and whether each neuron's spikes came in time order (both engines give
-    them so; when not, ``capped`` means nothing and the caller sorts)."""
-    finite = True
-    for j in range(v.size):
-        if not (math.isfinite(v[j]) and math.isfinite(u[j])):
-            finite = False
-    last, capped, ordered = np.full(v.size, -2, np.int64), False, True
+def cap_scan(idx, stp, n_neurons):
+    """(capped, ordered) in one pass: whether a neuron spiked on consecutive steps, and whether each
+    neuron's spikes came in time order (both engines give them so; when not, ``capped`` means
+    nothing and the caller sorts)."""
+    last, capped, ordered = np.full(n_neurons, -2, np.int64), False, True
     for k in range(idx.size):
         if stp[k] == last[idx[k]] + 1:
             capped = True
         elif stp[k] <= last[idx[k]]:
             ordered = False
         last[idx[k]] = stp[k]
+    return capped, ordered
+
+
+@nb.njit(cache=True, nogil=True)
+def spike_checks(idx, stp, v, u):
+    """(finite, capped, ordered): whether ``v`` and ``u`` are finite, then `cap_scan`."""
+    finite = True
+    for j in range(v.size):
+        if not (math.isfinite(v[j]) and math.isfinite(u[j])):
+            finite = False
+    capped, ordered = cap_scan(idx, stp, v.size)
     return finite, capped, ordered
 
 

@@ -231,10 +231,9 @@ def check_integration(neuron, step, v, u, current, method, dt) -> None:
             f"currents up to {np.abs(current).max():.3g} mV/ms; use a smaller dt or method='euler'"
         )
     if neuron.size > 1:
-        from .direct import spike_checks
+        from .direct import cap_scan
 
-        rest = np.zeros(int(neuron.max()) + 1)  # the state was checked above: only the spikes matter here
-        _, capped, ordered = spike_checks(np.asarray(neuron, np.int64), np.asarray(step, np.int64), rest, rest)
+        capped, ordered = cap_scan(np.asarray(neuron, np.int64), np.asarray(step, np.int64), int(neuron.max()) + 1)
         if ordered and not capped:  # one pass, no sort: the common case
             return
         order = np.lexsort((step, neuron))

@@ -46,8 +46,6 @@ __all__ = ["FusedPlan", "mix_forces", "mixing_matrix"]
 
 # Rows of the per-afferent float table.
 _COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA = range(12)
-# Rows of the per-afferent integer table.
-_GROUP, _TUNED = range(2)
 # Rows of the per-group float and integer tables.
 _ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS = range(5)
 _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = range(9)
@@ -171,7 +169,7 @@ def mix_forces(forces, weights):
 
 
 @nb.njit(cache=True, nogil=True)
-def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f, grp_i,
+def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, grp_f, grp_i,
            sos, fs, smooth_reading, outside_value, f_th, opponent):
     """Force to linear drive (n, n_afferents); ``state`` updated in place (`_front_range` on every afferent).
 
@@ -179,29 +177,29 @@ def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, s
     cache over all samples (one range of Brian2's 4096-wide blocks cost
     about twice as much per afferent-sample).
     """
-    out = np.empty((forces.shape[0] if not mixed else sites.shape[0], aff_i.shape[1]))
-    m = aff_i.shape[1]
+    out = np.empty((forces.shape[0] if not mixed else sites.shape[0], aff_f.shape[1]))
+    m = aff_f.shape[1]
     for a0 in range(0, m, _RANGE):
-        _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i,
+        _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f,
                      grp_f, grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, a0,
                      min(m, a0 + _RANGE))
     return out
 
 
 @nb.njit(cache=True, nogil=True, parallel=True)
-def _front_parts(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f,
+def _front_parts(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, grp_f,
                  grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, bounds):
     """`_front` with the afferent ranges ``bounds[p]..bounds[p+1]`` in parallel (afferents are independent)."""
-    out = np.empty((forces.shape[0] if not mixed else sites.shape[0], aff_i.shape[1]))
+    out = np.empty((forces.shape[0] if not mixed else sites.shape[0], aff_f.shape[1]))
     for p in nb.prange(bounds.size - 1):
-        _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i,
+        _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f,
                      grp_f, grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, bounds[p],
                      bounds[p + 1])
     return out
 
 
 @nb.njit(cache=True, nogil=True)
-def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, aff_i, grp_f,
+def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, grp_f,
                  grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, a0, a1):
     """Force to linear drive of the afferents ``a0..a1`` into ``out`` (n, n_afferents); their ``state`` in place.
 
@@ -211,7 +209,7 @@ def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, st
     one type, tuned or not) are the outer loop, so each inner loop over
     afferents has loop-invariant constants and branches.
     """
-    n, m, rows = out.shape[0], aff_i.shape[1], 2 * sos.shape[1]
+    n, m, rows = out.shape[0], aff_f.shape[1], 2 * sos.shape[1]
     z, offset = state[:rows], state[rows + _OFFSET]
     y1, y2, slow = state[rows + _Y1], state[rows + _Y2], state[rows + _SLOW]
     f, words, xi, af = np.empty(m), np.empty(m, np.uint64), np.empty(m), np.empty(m)
@@ -256,7 +254,7 @@ def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, st
 
 
 @nb.njit(cache=True, nogil=True)
-def _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i, sigma_idx):
+def _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i, sigma_idx):
     """Low-pass, bias and additive noise of the transduced drive, in place; returns the smallest current.
 
     Additive noise is drawn for the afferents ``sigma_idx`` (those with
@@ -289,7 +287,7 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f
 
 
 @nb.njit(cache=True, nogil=True)
-def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i, sigma_idx,
+def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i, sigma_idx,
                         substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, integrate):
     """`_back`, then (if ``integrate``) the direct engine on the current.
 
@@ -297,7 +295,7 @@ def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f
     whether a neuron spiked on consecutive steps (the one-spike-per-step cap
     bound): the seam's checks need the full spike lists only then.
     """
-    lowest = _back(current, key, additive, ids, sample0, state, rows, aff_f, aff_i, grp_f, grp_i, sigma_idx)
+    lowest = _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i, sigma_idx)
     if not integrate:
         return np.empty(0, np.int64), np.empty(0, np.int64), lowest, True, False
     idx, stp = _integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, 0,
@@ -359,7 +357,7 @@ class FusedPlan:
         spans = list(zip(bounds[:-1], bounds[1:]))
         consts = [_stage_constants(params, str(afferent_type[a]), self.fs) for a, _ in spans]
         noise_cv, noise_sigma = np.asarray(noise_cv, dtype=float), np.asarray(noise_sigma, dtype=float)
-        self.aff_f, self.aff_i = self._afferent_tables(afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma,
+        self.aff_f = self._afferent_tables(afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma,
                                                        spans, consts)
         self.grp_f, self.grp_i, self.sos = self._group_tables(spans, consts, noise_cv, nap != UNTUNED)
         self.rows = 2 * self.sos.shape[1]
@@ -376,7 +374,7 @@ class FusedPlan:
 
     def _afferent_tables(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, spans, consts):
         n = self.n_afferents
-        aff_f, aff_i = np.zeros((12, n)), np.zeros((2, n), dtype=np.int64)
+        aff_f = np.zeros((12, n))
         tuned = nap != UNTUNED
         rad = np.deg2rad(np.asarray(theta_t, dtype=float))
         aff_f[_COS], aff_f[_SIN], aff_f[_K] = np.cos(rad), np.sin(rad), np.asarray(k, dtype=float)
@@ -386,13 +384,11 @@ class FusedPlan:
             aff_f[_P1:_P5 + 1, rows] = np.array([profile.p1, profile.p2, profile.p3, profile.p4, profile.p5])[:, None]
             aff_f[_TIP, rows] = tip_radius(str(name))
         scale = np.asarray(scale, dtype=float)
-        for g, ((a, b), (stage, *_)) in enumerate(zip(spans, consts)):
-            aff_i[_GROUP, a:b] = g
+        for (a, b), (stage, *_) in zip(spans, consts):
             aff_f[_GAIN, a:b] = stage.gain * scale[a:b]  # as `current_core`
         aff_f[_CV] = noise_cv / np.sqrt(1000.0 / self.fs)  # as `current_core` and `_receptor_noise`
         aff_f[_SIGMA] = noise_sigma / np.sqrt(1000.0 / self.fs)  # as `noise_current`
-        aff_i[_TUNED] = tuned
-        return aff_f, aff_i
+        return aff_f
 
     def _group_tables(self, spans, consts, noise_cv, tuned):
         n_groups, n_sec = len(spans), max([sos.shape[0] for _, sos, _, _ in consts] + [1])
@@ -455,7 +451,7 @@ class FusedPlan:
                              f"got shape {forces.shape}")
         args = (_NO_FORCES if mixed else forces, forces if mixed else _NO_SITES, self.mixing if mixed else _NO_WEIGHTS,
                 mixed, np.uint64(key or 0), noisy, self.afferent_id, int(sample0), state, started, self.aff_f,
-                self.aff_i, self.grp_f, self.grp_i, self.sos, self.fs, self.smooth_reading, self.outside_value,
+                self.grp_f, self.grp_i, self.sos, self.fs, self.smooth_reading, self.outside_value,
                 self.f_th, self.opponent)
         # The parallel kernel is called from here, never from a cached kernel
         # (numba's cache does not track a cached caller's parallel callee).
@@ -476,7 +472,7 @@ class FusedPlan:
         """
         current = self._drive(forces, state, started, sample0, key)
         _back(current, np.uint64(key or 0), key is not None and self.additive, self.afferent_id, int(sample0), state,
-              self.rows, self.aff_f, self.aff_i, self.grp_f, self.grp_i, self.sigma_idx)
+              self.rows, self.aff_f, self.grp_f, self.grp_i, self.sigma_idx)
         return current
 
     def spikes(self, forces, state, started, sample0, key, neuron, v, u, parts=1):
@@ -495,7 +491,7 @@ class FusedPlan:
         substeps, method, h, half, a, b, c, d, v_peak, v_floor, block = neuron
         serial = bounds.size <= 2
         out = _back_and_integrate(current, np.uint64(key or 0), key is not None and self.additive, self.afferent_id,
-                                  int(sample0), state, self.rows, self.aff_f, self.aff_i, self.grp_f, self.grp_i,
+                                  int(sample0), state, self.rows, self.aff_f, self.grp_f, self.grp_i,
                                   self.sigma_idx, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
                                   serial)
         if not serial:  # from Python, as the front's parallel kernel
