@@ -90,6 +90,7 @@ def _signature(obj) -> str:
 
 def _entry(module, name: str) -> str:
     obj = getattr(module, name)
+    obj = getattr(obj, "py_func", obj)  # a numba kernel: document the Python function it compiles
     if inspect.isfunction(obj) or inspect.isclass(obj):
         signature = _signature(obj)
         kind = "class " if inspect.isclass(obj) else ""
