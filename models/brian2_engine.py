@@ -55,7 +55,7 @@ from .neuron import V_FLOOR
 __all__ = ["run_brian2", "cache_dir", "Brian2Warning"]
 
 _COMPILE_ARGS = ["-w", "-O3", "-ffp-contract=off", "-march=native", "-std=c++11"]
-_TEMPLATE_VERSION = "2"  # bump when the generated network changes
+_TEMPLATE_VERSION = "3"  # bump when the generated network changes
 _NEURON_QUANTUM = 32  # neuron padding granularity
 _SAMPLE_QUANTUM = 250  # sample padding granularity
 _MAX_ELEMENTS = 1 << 25  # TimedArray elements per run: 256 MB, far below 2**31
@@ -105,6 +105,7 @@ _BUILDS: dict = {}  # key -> _Build, for this process
 _LOCK = threading.RLock()  # Brian2's device is process-global: one build at a time
 _FREE_LANES: queue.SimpleQueue = queue.SimpleQueue()
 _LANE_COUNT = [0]
+_DEVICE: list = []  # the EngineDevice, made on the first build
 
 
 def _pad(n: int, quantum: int) -> int:
@@ -114,7 +115,9 @@ def _pad(n: int, quantum: int) -> int:
 def _key_dir(key: tuple) -> Path:
     brian2 = _import_brian2()
 
-    text = repr((key, brian2.__version__, _COMPILE_ARGS, _TEMPLATE_VERSION, _ODE, _VARIABLES, _IZHIKEVICH_2003))
+    here = Path(__file__).parent
+    ours = [p.read_bytes() for p in (here / "_brian2_device.py", *sorted((here / "brian2_templates").glob("*.cpp")))]
+    text = repr((key, brian2.__version__, _COMPILE_ARGS, _TEMPLATE_VERSION, _ODE, _VARIABLES, _IZHIKEVICH_2003, ours))
     digest = hashlib.sha256(text.encode()).hexdigest()[:16]
     n_neurons, n_samples, substeps, dt, method = key
     return cache_dir() / f"n{n_neurons}_t{n_samples}_s{substeps}_{method}_{digest}"
@@ -177,6 +180,15 @@ def _brian2_prefs():
             brian2.prefs[name] = value
 
 
+def _device():
+    """The process's `models._brian2_device.EngineDevice` (Brian2's standalone device, two loops cheaper)."""
+    if not _DEVICE:
+        from ._brian2_device import EngineDevice
+
+        _DEVICE.append(EngineDevice())
+    return _DEVICE[0]
+
+
 def _build(key: tuple) -> _Build:
     """Generate (and if needed compile) the standalone project for ``key``."""
     n_neurons, n_samples, substeps, dt, method = key
@@ -190,9 +202,7 @@ def _build(key: tuple) -> _Build:
             flush=True,
         )
     with _brian2_prefs() as b2:
-        from brian2.devices.device import all_devices
-
-        standalone = all_devices["cpp_standalone"]  # one singleton per process
+        standalone = _device()
         standalone.reinit()  # forget the previously built project, if any
         # Brian2 names objects uniquely among those alive; once the previous
         # build is gone, this build reuses the cached project's exact names
@@ -271,7 +281,8 @@ def _run_binary(build: _Build, lane: str, run_args: list) -> Path:
     env["GLIBC_TUNABLES"] = ":".join(filter(None, [env.get("GLIBC_TUNABLES", ""), "glibc.malloc.hugetlb=1"]))
     proc = subprocess.run(["./main", "--results_dir", f"{results}{os.sep}", *run_args], cwd=build.directory,
                           env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False)
-    if proc.returncode:
+    # A run argument's file of the wrong size is only reported on stderr (exit 0, default values used).
+    if proc.returncode or "Error" in proc.stderr:
         raise RuntimeError(f"the Brian2 binary failed (exit {proc.returncode}) in {build.directory}: "
                            f"{proc.stderr.strip()[-500:]}")
     return results

@@ -53,6 +53,7 @@ _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = ran
 _OFFSET, _Y1, _Y2, _SLOW, _SMOOTH = range(5)
 
 _RANGE = 512  # afferents per range of the front pass: its state and scratch fit in cache
+_SLICE = 1 << 17  # current elements per time slice of `FusedPlan.currents`
 _NO_NORMALS = np.zeros((0, 1)).T  # same layout as a transposed noise block
 _NO_FORCES, _NO_SITES, _NO_WEIGHTS = np.zeros((0, 3)), np.zeros((0, 0, 3)), np.zeros((0, 0))
 
@@ -170,14 +171,13 @@ def mix_forces(forces, weights):
 
 @nb.njit(cache=True, nogil=True)
 def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, grp_f, grp_i,
-           sos, fs, smooth_reading, outside_value, f_th, opponent):
-    """Force to linear drive (n, n_afferents); ``state`` updated in place (`_front_range` on every afferent).
+           sos, fs, smooth_reading, outside_value, f_th, opponent, out):
+    """Force to linear drive into ``out`` (n, n_afferents); ``state`` in place (`_front_range` on every afferent).
 
     Afferents go in ranges of `_RANGE`, whose state and scratch stay in
     cache over all samples (one range of Brian2's 4096-wide blocks cost
     about twice as much per afferent-sample).
     """
-    out = np.empty((forces.shape[0] if not mixed else sites.shape[0], aff_f.shape[1]))
     m = aff_f.shape[1]
     for a0 in range(0, m, _RANGE):
         _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f,
@@ -188,9 +188,8 @@ def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, s
 
 @nb.njit(cache=True, nogil=True, parallel=True)
 def _front_parts(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, grp_f,
-                 grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, bounds):
+                 grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, bounds):
     """`_front` with the afferent ranges ``bounds[p]..bounds[p+1]`` in parallel (afferents are independent)."""
-    out = np.empty((forces.shape[0] if not mixed else sites.shape[0], aff_f.shape[1]))
     for p in nb.prange(bounds.size - 1):
         _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f,
                      grp_f, grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, bounds[p],
@@ -444,7 +443,7 @@ class FusedPlan:
         """Filter, offset, difference, adaptation and smoothing state at rest, shape (n_rows, n_afferents)."""
         return np.zeros((self.rows + 5, self.n_afferents))
 
-    def _drive(self, forces, state, started, sample0, key, bounds=None):
+    def _drive(self, forces, state, started, sample0, key, bounds=None, out=None):
         noisy, mixed = key is not None, self.mixing is not None
         if forces.ndim != (3 if mixed else 2):
             raise ValueError(f"forces must be {'(n, n_sites, 3) site forces' if mixed else '(n, 3)'} for this plan, "
@@ -452,7 +451,7 @@ class FusedPlan:
         args = (_NO_FORCES if mixed else forces, forces if mixed else _NO_SITES, self.mixing if mixed else _NO_WEIGHTS,
                 mixed, np.uint64(key or 0), noisy, self.afferent_id, int(sample0), state, started, self.aff_f,
                 self.grp_f, self.grp_i, self.sos, self.fs, self.smooth_reading, self.outside_value,
-                self.f_th, self.opponent)
+                self.f_th, self.opponent, np.empty((forces.shape[0], self.n_afferents)) if out is None else out)
         # The parallel kernel is called from here, never from a cached kernel
         # (numba's cache does not track a cached caller's parallel callee).
         drive = _front(*args) if bounds is None or bounds.size <= 2 else _front_parts(*args, bounds)
@@ -470,7 +469,16 @@ class FusedPlan:
         a stream ``key`` (`models.rng.stream_key`), the noise of sample n of
         afferent a is ``models.rng.normal(key, a, n)``; None: noise-free.
         """
-        current = self._drive(forces, state, started, sample0, key)
+        n, step = forces.shape[0], max(1, _SLICE // max(1, self.n_afferents))
+        if n <= step:
+            return self._current_slice(forces, state, started, sample0, key)
+        out = np.empty((n, self.n_afferents))
+        for t0 in range(0, n, step):  # slices of time (contiguous rows of ``out``): each one's passes stay in cache
+            self._current_slice(forces[t0 : t0 + step], state, started or t0 > 0, sample0 + t0, key, out[t0 : t0 + step])
+        return out
+
+    def _current_slice(self, forces, state, started, sample0, key, out=None):
+        current = self._drive(forces, state, started, sample0, key, out=out)
         _back(current, np.uint64(key or 0), key is not None and self.additive, self.afferent_id, int(sample0), state,
               self.rows, self.aff_f, self.grp_f, self.grp_i, self.sigma_idx)
         return current

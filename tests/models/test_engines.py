@@ -110,3 +110,44 @@ def test_pipeline_bad_input(kwargs, match):
     args.update(kwargs)
     with pytest.raises(ValueError, match=match):
         simulate(args.pop("fx"), args.pop("fy"), args.pop("fz"), **args)
+
+
+def test_engines_identical_across_thresholder_blocks():
+    """The Brian2 engine's thresholder scans 64 neurons at a time (`models/brian2_templates/threshold.cpp`).
+
+    150 neurons (160 with padding: blocks of 64, 64 and 32) spiking at
+    different steps, including the first and last neuron of every block.
+    """
+    rng = np.random.default_rng(5)
+    current = rng.uniform(0.0, 30.0, (120, 150)) * np.linspace(0.2, 1.5, 150)
+    a = integrate(current, fs=1000.0, dt=1e-4, afferent_type="RAI", engine="direct")
+    b = integrate(current, fs=1000.0, dt=1e-4, afferent_type="RAI", engine="brian2")
+    assert {0, 63, 64, 127, 128, 149} <= set(a.afferent.tolist())
+    assert spikes(a) == spikes(b)
+
+
+def test_brian2_network_loop_reads_the_clock_once():
+    """Brian2's network loop reads the process CPU clock (a system call) after every step; the engine's, once."""
+    from models._brian2_device import EngineCodeObject, drop_per_step_clock
+
+    def loop(source):
+        start = source.index("while(clock")
+        return source[start:source.index("Network::_globally_running = false;", start)]
+
+    source = EngineCodeObject.templater.network(None, None, maximum_run_time=None).cpp_file
+    assert loop(source).count("std::clock()") == 2  # Brian2's loop: if this fails, the patch no longer applies
+    patched = drop_per_step_clock(source)
+    assert loop(patched).count("std::clock()") == 1  # the report's read, made only when a report is asked for
+    assert "elapsed_realtime = (double)(std::clock() - start)" in patched
+
+
+def test_brian2_refuses_an_input_file_it_could_not_read(monkeypatch):
+    """Brian2's binary only prints an error for a run argument's file of the wrong size, and exits 0."""
+    import models.brian2_engine as engine
+
+    def short_table(path, current, n_samples, n_neurons):
+        np.zeros(7).tofile(path)
+
+    monkeypatch.setattr(engine, "_write_table", short_table)
+    with pytest.raises(RuntimeError, match="file size"):
+        integrate(np.full((90, 7), 20.0), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")

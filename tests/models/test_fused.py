@@ -74,6 +74,23 @@ def test_fused_currents_equal_the_stage_by_stage_path(seed, no_shear, physio, no
     np.testing.assert_array_equal(np.concatenate(parts), expected)
 
 
+@pytest.mark.parametrize("per_slice", [1, 37, 400])
+def test_fused_currents_in_time_slices_equal_the_stage_by_stage_path(monkeypatch, per_slice):
+    """`FusedPlan.currents` cuts long inputs into slices of time that fit in cache; the cut changes no bit."""
+    import models.fused
+
+    monkeypatch.setattr(models.fused, "_SLICE", per_slice * len(TYPES))
+    rng = np.random.default_rng(11)
+    n = len(TYPES)
+    theta, k, scale = rng.uniform(0, 360, n), rng.uniform(2.0, 5.0, n), rng.uniform(0.5, 2.0, n)
+    cv, sigma = np.full(n, 0.4), np.where(np.array(TYPES) == "SAII", 0.5, 0.0)
+    f, ids = forces(5), np.arange(n)
+    normals = keyed_normals(9, ids, 0, f.shape[0])
+    expected = reference(f, PHYSIO, "smooth", scale, cv, sigma, theta, k, normals)
+    plan = FusedPlan(TYPES, NAPS, theta, k, scale, cv, sigma, PHYSIO, FS, "smooth", 0.1, ids)
+    np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False, 0, 9), expected)
+
+
 def held_forces(seed, n=400):
     """Shear held in a few directions: above F_TH at A, below it while turning to B, above it at B, back to A.
 
