@@ -1,10 +1,12 @@
 """``ddmm bench``: the whole pipeline's speed and memory, measured side by side.
 
 Every case runs in a fresh Python process, so peak RSS is the case's own.
-In-process cases do one untimed warm-up run first (the Brian2 build for the
-shape and the numba kernels are cached on disk after it), then report the
-median of three timed runs of the pipeline spec -> forces -> spikes ->
-Dataset (the integration kernel alone is timed the same way).  The cold-start case times a
+In-process cases do two untimed warm-up runs first (the Brian2 build for the
+shape and the numba kernels are cached on disk after the first; the second
+settles the page cache and the Brian2 binary's memory, which the first
+timed runs still paid for), then report the median of five timed runs of
+the pipeline spec -> forces -> spikes -> Dataset (the integration kernel
+alone is timed the same way).  The cold-start case times a
 fresh ``ddmm simulate`` process writing a file, after a first process has
 filled the caches; that first process's extra time is reported separately
 as the one-time compile.
@@ -56,8 +58,8 @@ def _pipeline(population: str, engine: str, sim_s: float):
     return len(pop), ds
 
 
-#: Timed runs of a warm case; its wall time is their median (the host is shared and noisy).
-REPEATS = 3
+#: Untimed and timed runs of a warm case; its wall time is the timed runs' median (the host is shared and noisy).
+WARMUPS, REPEATS = 2, 5
 
 
 def _median_wall(run, repeats: int = REPEATS):
@@ -75,11 +77,11 @@ def _median_wall(run, repeats: int = REPEATS):
 def run_case(name: str) -> dict:
     """Run one case in this process and return its measurements.
 
-    A warm case: one untimed run, then the median of `REPEATS` timed runs.
+    A warm case: `WARMUPS` untimed runs, then the median of `REPEATS` timed runs.
     A cold case (hand x 10 s, for its peak memory): one timed run.
     """
     population, engine, sim_s, warm = CASES[name]
-    if warm:
+    for _ in range(WARMUPS if warm else 0):
         _pipeline(population, engine, sim_s)
     wall, (n, ds) = _median_wall(lambda: _pipeline(population, engine, sim_s), REPEATS if warm else 1)
     result = {"name": name, "engine": engine, "n_afferents": n, "sim_s": sim_s, "dt_ms": DT * 1e3,
