@@ -22,9 +22,10 @@ Design (measured on this machine kind, see docs/user-guide.md, "Engines"):
   ``t`` reaches ``t_end`` (a run argument), before the padded steps run.
 * **Lanes: runs in parallel.**  The binary is run directly (as Brian2's
   ``device.run`` does, but without changing the process's working
-  directory), each concurrent caller in its own *lane*: its own input files
-  and its own ``--results_dir``.  Two blocks in flight then integrate on two
-  cores; only generating and compiling a project is serialised.
+  directory), each concurrent caller in its own *lane* (`models._brian2_lanes`):
+  its own input files and ``--results_dir``, kept and rewritten in place
+  from run to run.  Two blocks in flight then integrate on two cores; only
+  generating and compiling a project is serialised.
 * **32-bit TimedArray index.**  Brian2 indexes ``timestep*N + i`` with an
   ``int``; runs are cut into time chunks so that ``n_samples * n_neurons``
   stays far below 2**31.
@@ -36,8 +37,6 @@ import gc
 import hashlib
 import logging
 import os
-import queue
-import shutil
 import subprocess
 import sys
 import threading
@@ -46,6 +45,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+from ._brian2_lanes import lane, write_table
 from ._cache import cache_root
 
 import numpy as np
@@ -110,8 +110,6 @@ class _Build:
 
 _BUILDS: dict = {}  # key -> _Build, for this process
 _LOCK = threading.RLock()  # Brian2's device is process-global: one build at a time
-_FREE_LANES: queue.SimpleQueue = queue.SimpleQueue()
-_LANE_COUNT = [0]
 _DEVICE: list = []  # the EngineDevice, made on the first build
 
 
@@ -265,25 +263,9 @@ def _activate(key: tuple) -> _Build:
         return _BUILDS[key]
 
 
-@contextmanager
-def _lane():
-    """A lane no other thread or process is using: its own input files and results directory."""
-    try:
-        lane = _FREE_LANES.get_nowait()
-    except queue.Empty:
-        with _LOCK:
-            lane = f"{os.getpid()}_{_LANE_COUNT[0]}"
-            _LANE_COUNT[0] += 1
-    try:
-        yield lane
-    finally:
-        _FREE_LANES.put(lane)
-
-
-def _run_binary(build: _Build, lane: str, run_args: list) -> Path:
+def _run_binary(build: _Build, lane: Path, run_args: list) -> Path:
     """Run the compiled binary in ``lane``; return its results directory."""
-    results = build.directory / f"results_{lane}"
-    results.mkdir(exist_ok=True)
+    results = lane / "results"
     env = dict(os.environ, LD_BIND_NOW="1")  # Brian2's default run environment
     # The binary allocates its 25 MB current table afresh on every run: on
     # transparent huge pages its page faults cost ~30% less of the run
@@ -298,26 +280,8 @@ def _run_binary(build: _Build, lane: str, run_args: list) -> Path:
     return results
 
 
-def _write_table(path: Path, current, n_samples: int, n_neurons: int) -> None:
-    """The binary's (n_samples, n_neurons) float64 current table: ``current`` with zero padding.
-
-    Padded neurons are zero columns written with the rows; padded samples
-    are a hole at the end of the file, which reads as zeros (a memory map
-    measured slower: a page fault per 4 kB).
-    """
-    rows = current
-    if current.shape[1] != n_neurons or current.dtype != np.float64 or not current.flags.c_contiguous:
-        rows = np.empty((current.shape[0], n_neurons))
-        rows[:, : current.shape[1]] = current
-        rows[:, current.shape[1]:] = 0.0
-    with open(path, "wb") as f:
-        rows.tofile(f)
-        f.truncate(n_samples * n_neurons * 8)
-
-
 def _run_chunk(build: _Build, lane: str, current, params, v, u):
     """Run the compiled binary once on a padded chunk; return spikes and final state."""
-    static = build.directory / "static_arrays"
     n_real = current.shape[1]
     files = {}
     for name, arr, fill in (("v", v, -70.0), ("u", u, -14.0), ("a", params["a"], 0.02),
@@ -327,21 +291,16 @@ def _run_chunk(build: _Build, lane: str, current, params, v, u):
         files[f"afferents.{name}"] = full
     t_end = current.shape[0] * build.key[2] * build.key[3]  # samples * substeps * dt, in s
     run_args = [f"afferents.t_end={t_end!r}"]
-    inputs = [static / f"ddmm_{lane}_ddmm_current_values.dat"]
-    _write_table(inputs[0], current, build.n_samples, build.n_neurons)
-    run_args.append(f"ddmm_current.values=static_arrays/{inputs[0].name}")
+    table = lane / "ddmm_current.dat"  # absolute paths: Brian2 reads a value where one starts with a digit
+    write_table(table, current, build.n_samples, build.n_neurons)
+    run_args.append(f"ddmm_current.values={table}")
     for target, arr in files.items():
-        inputs.append(static / f"ddmm_{lane}_{target.replace('.', '_')}.dat")
-        arr.tofile(inputs[-1])
-        run_args.append(f"{target}=static_arrays/{inputs[-1].name}")
-    try:
-        results = _run_binary(build, lane, run_args)
-        read = {name: np.fromfile(results / fname, dtype=np.int32 if name == "i" else np.float64)
-                for name, fname in build.results.items()}
-    finally:  # a lane's files live for one run: nothing accumulates in the cache
-        for path in inputs:
-            path.unlink(missing_ok=True)
-        shutil.rmtree(build.directory / f"results_{lane}", ignore_errors=True)
+        path = lane / f"{target}.dat"
+        arr.tofile(path)
+        run_args.append(f"{target}={path}")
+    results = _run_binary(build, lane, run_args)
+    read = {name: np.fromfile(results / fname, dtype=np.int32 if name == "i" else np.float64)
+            for name, fname in build.results.items()}
     neuron = read["i"].astype(np.int64)
     step = np.rint(read["t"] / build.key[3]).astype(np.int64)
     keep = neuron < n_real
@@ -358,8 +317,8 @@ def run_brian2(current, substeps, dt, params, v, u, method="euler", v_peak=30.0,
     """
     if v_peak != 30.0 or v_floor != V_FLOOR:
         raise ValueError(f"the Brian2 engine is built for v_peak = 30 and v_floor = {V_FLOOR} mV")
-    with _lane() as lane:
-        return _run_lanes(lane, current, substeps, dt, params, v, u, method)
+    with lane() as path:
+        return _run_lanes(path, current, substeps, dt, params, v, u, method)
 
 
 def _run_lanes(lane, current, substeps, dt, params, v, u, method):

@@ -148,6 +148,30 @@ def test_brian2_refuses_an_input_file_it_could_not_read(monkeypatch):
     def short_table(path, current, n_samples, n_neurons):
         np.zeros(7).tofile(path)
 
-    monkeypatch.setattr(engine, "_write_table", short_table)
+    monkeypatch.setattr(engine, "write_table", short_table)
     with pytest.raises(RuntimeError, match="file size"):
         integrate(np.full((90, 7), 20.0), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")
+
+
+def test_brian2_lanes_live_as_long_as_their_process():
+    """A lane's files are kept between runs, removed at exit, and swept once their process is gone."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from models._brian2_lanes import _root
+
+    stale = _root() / "4194305_0"  # above Linux's largest pid: a process that cannot be alive
+    (stale / "results").mkdir(parents=True, exist_ok=True)
+    code = ("import os, numpy as np; from models.engines import integrate; from models._brian2_lanes import _root\n"
+            "for _ in range(2):\n"
+            "    integrate(np.full((90, 7), 20.0), fs=1000.0, dt=1e-4, afferent_type='SAI', engine='brian2')\n"
+            "mine = sorted(p.name for p in _root().iterdir() if p.name.startswith(f'{os.getpid()}_'))\n"
+            "print(os.getpid(), mine, sorted(p.name for p in (_root() / mine[0]).iterdir()))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         cwd=Path(__file__).parents[2]).stdout.split(maxsplit=1)
+    assert not stale.exists()
+    assert out[1].startswith(f"['{out[0]}_0'] ")  # one lane, used by both runs
+    assert "'ddmm_current.dat'" in out[1] and "'results'" in out[1]
+    assert not any(p.name.startswith(f"{out[0]}_") for p in _root().iterdir())
