@@ -6,13 +6,16 @@ Design (measured on this machine kind, see docs/user-guide.md, "Engines"):
   shape ``(n_neurons, n_samples)`` plus dt, substeps and method, compiled
   once and cached on disk (``$DDMM_CACHE_DIR/brian2/<key>``, default
   ``~/.cache/ddmm``).  Calls that change only input values re-run the same
-  binary with Brian2's ``run_args``: the currents (a `TimedArray`), the
-  initial v and u, and the per-neuron a, b, c, d are all files handed to the
-  binary, so nothing recompiles.  A one-line notice is printed whenever a
-  shape is compiled.
+  binary: the initial v and u and the per-neuron a, b, c, d with Brian2's
+  ``run_args``, and the current table (a file the binary maps, named in
+  its environment), so nothing recompiles.  A one-line notice is printed
+  whenever a shape is compiled.
 * **Inputs at the force rate.**  The current is sampled at ``fs`` and held
   for ``substeps`` steps: a ``run_regularly`` operation at ``1/fs`` copies
-  the TimedArray row into ``I_in``, which the state updater reads.
+  the table's row into ``I_in``, which the state update reads.  The table
+  is read by ``ddmm_input`` (`models._brian2_device.input_function`), a
+  Brian2 function with a C++ body that memory-maps the lane's file, where
+  a `TimedArray` would copy it into fresh memory on every run.
 * **Same arithmetic as the direct engine.**  The project is compiled without
   ``-ffast-math`` and with ``-ffp-contract=off`` (no fused multiply-adds),
   and `models.direct` mirrors the generated expressions.
@@ -26,9 +29,8 @@ Design (measured on this machine kind, see docs/user-guide.md, "Engines"):
   its own input files and ``--results_dir``, kept and rewritten in place
   from run to run.  Two blocks in flight then integrate on two cores; only
   generating and compiling a project is serialised.
-* **32-bit TimedArray index.**  Brian2 indexes ``timestep*N + i`` with an
-  ``int``; runs are cut into time chunks so that ``n_samples * n_neurons``
-  stays far below 2**31.
+* **Bounded tables.**  Runs are cut into time chunks of at most 2**25
+  table elements (256 MB).
 """
 
 from __future__ import annotations
@@ -55,10 +57,10 @@ from .neuron import V_FLOOR
 __all__ = ["run_brian2", "cache_dir", "Brian2Warning"]
 
 _COMPILE_ARGS = ["-w", "-O3", "-ffp-contract=off", "-march=native", "-std=c++11"]
-_TEMPLATE_VERSION = "3"  # bump when the generated network changes
+_TEMPLATE_VERSION = "4"  # bump when the generated network changes
 _NEURON_QUANTUM = 32  # neuron padding granularity
 _SAMPLE_QUANTUM = 250  # sample padding granularity
-_MAX_ELEMENTS = 1 << 25  # TimedArray elements per run: 256 MB, far below 2**31
+_MAX_ELEMENTS = 1 << 25  # current table elements per run: 256 MB
 
 _ODE = """
 dv/dt = (0.04*v**2 + 5*v + 140 - u + I_in)/ms : 1
@@ -215,7 +217,9 @@ def _build(key: tuple) -> _Build:
         gc.collect()
         b2.set_device(standalone, directory=str(directory), build_on_run=False)
         fs = 1.0 / (dt * substeps)
-        ta = b2.TimedArray(np.zeros((n_samples, n_neurons)), dt=(1.0 / fs) * b2.second, name="ddmm_current")
+        from ._brian2_device import input_function
+
+        ddmm_input = input_function(n_samples, n_neurons, fs)
         explicit = method in ("izhikevich2003", "euler")
         group = b2.NeuronGroup(
             n_neurons, (_STATE if explicit else _ODE) + _VARIABLES, threshold="v >= 30", reset="v = c; u += d",
@@ -230,7 +234,7 @@ def _build(key: tuple) -> _Build:
         # Hold the current for one sample; when t reaches t_end (the end of the
         # real input) copy the state, which later padded steps then overwrite.
         code = (
-            "I_in = ddmm_current(t, i)\n"
+            "I_in = ddmm_input(t, i)\n"
             f"at_end = int(abs(t - t_end) < {0.5 / fs!r}*second)\n"
             "v_end = at_end*v + (1 - at_end)*v_end\n"
             "u_end = at_end*u + (1 - at_end)*u_end"
@@ -242,13 +246,9 @@ def _build(key: tuple) -> _Build:
         group.t_end = n_samples * substeps * dt * b2.second
         monitor = b2.SpikeMonitor(group, name="spikes")
         net = b2.Network(group, monitor)
-        net.run(n_samples * substeps * dt * b2.second, namespace={"ddmm_current": ta, "ms": b2.ms})
+        net.run(n_samples * substeps * dt * b2.second, namespace={"ddmm_input": ddmm_input, "ms": b2.ms})
         standalone.build(directory=str(directory), run=False, with_output=False)
         b2.set_device("runtime")  # leave the user's Brian2 in its default mode
-        # Every run hands the binary its current as a run argument, which
-        # the binary loads after its compiled-in default: empty the default
-        # (25 MB of zeros read for nothing on every run otherwise).
-        (directory / "static_arrays" / "ddmm_current_values").write_bytes(b"")
         results = {name: standalone.get_array_filename(owner.variables[name])
                    for owner, names in ((group, ("v", "u", "v_end", "u_end")), (monitor, ("i", "t")))
                    for name in names}
@@ -263,24 +263,22 @@ def _activate(key: tuple) -> _Build:
         return _BUILDS[key]
 
 
-def _run_binary(build: _Build, lane: Path, run_args: list) -> Path:
-    """Run the compiled binary in ``lane``; return its results directory."""
+def _run_binary(build: _Build, lane: Path, table: Path, run_args: list) -> Path:
+    """Run the compiled binary in ``lane`` on the current ``table``; return its results directory."""
+    from ._brian2_device import TABLE_ENV
+
     results = lane / "results"
-    env = dict(os.environ, LD_BIND_NOW="1")  # Brian2's default run environment
-    # The binary allocates its 25 MB current table afresh on every run: on
-    # transparent huge pages its page faults cost ~30% less of the run
-    # (glibc >= 2.35; ignored elsewhere, and the arithmetic is the same).
-    env["GLIBC_TUNABLES"] = ":".join(filter(None, [env.get("GLIBC_TUNABLES", ""), "glibc.malloc.hugetlb=1"]))
+    env = dict(os.environ, LD_BIND_NOW="1", **{TABLE_ENV: str(table)})  # LD_BIND_NOW: Brian2's run environment
     proc = subprocess.run(["./main", "--results_dir", f"{results}{os.sep}", *run_args], cwd=build.directory,
                           env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False)
-    # A run argument's file of the wrong size is only reported on stderr (exit 0, default values used).
+    # Brian2 reports a run argument's file of the wrong size only on stderr (exit 0, defaults used).
     if proc.returncode or "Error" in proc.stderr:
         raise RuntimeError(f"the Brian2 binary failed (exit {proc.returncode}) in {build.directory}: "
                            f"{proc.stderr.strip()[-500:]}")
     return results
 
 
-def _run_chunk(build: _Build, lane: str, current, params, v, u):
+def _run_chunk(build: _Build, lane: Path, current, params, v, u):
     """Run the compiled binary once on a padded chunk; return spikes and final state."""
     n_real = current.shape[1]
     files = {}
@@ -291,14 +289,13 @@ def _run_chunk(build: _Build, lane: str, current, params, v, u):
         files[f"afferents.{name}"] = full
     t_end = current.shape[0] * build.key[2] * build.key[3]  # samples * substeps * dt, in s
     run_args = [f"afferents.t_end={t_end!r}"]
-    table = lane / "ddmm_current.dat"  # absolute paths: Brian2 reads a value where one starts with a digit
+    table = lane / "ddmm_current.dat"
     write_table(table, current, build.n_samples, build.n_neurons)
-    run_args.append(f"ddmm_current.values={table}")
-    for target, arr in files.items():
+    for target, arr in files.items():  # absolute paths: Brian2 reads a value where one starts with a digit
         path = lane / f"{target}.dat"
         arr.tofile(path)
         run_args.append(f"{target}={path}")
-    results = _run_binary(build, lane, run_args)
+    results = _run_binary(build, lane, table, run_args)
     read = {name: np.fromfile(results / fname, dtype=np.int32 if name == "i" else np.float64)
             for name, fname in build.results.items()}
     neuron = read["i"].astype(np.int64)

@@ -149,7 +149,7 @@ def test_brian2_refuses_an_input_file_it_could_not_read(monkeypatch):
         np.zeros(7).tofile(path)
 
     monkeypatch.setattr(engine, "write_table", short_table)
-    with pytest.raises(RuntimeError, match="file size"):
+    with pytest.raises(RuntimeError, match="Error reading the current table"):
         integrate(np.full((90, 7), 20.0), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")
 
 
