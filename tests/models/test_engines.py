@@ -175,3 +175,17 @@ def test_brian2_lanes_live_as_long_as_their_process():
     assert out[1].startswith(f"['{out[0]}_0'] ")  # one lane, used by both runs
     assert "'ddmm_current.dat'" in out[1] and "'results'" in out[1]
     assert not any(p.name.startswith(f"{out[0]}_") for p in _root().iterdir())
+
+
+def test_brian2_table_is_padded_with_zeros_whatever_the_lane_held(tmp_path):
+    """The lane's table file is rewritten in place: padding must not keep an earlier run's values."""
+    from models._brian2_lanes import write_table
+
+    path = tmp_path / "table.dat"
+    write_table(path, np.full((8, 4), 7.0), 8, 4)
+    write_table(path, np.arange(6.0).reshape(2, 3), 8, 4)  # fewer samples and neurons than the table
+    table = np.fromfile(path).reshape(8, 4)
+    np.testing.assert_array_equal(table[:2, :3], np.arange(6.0).reshape(2, 3))
+    assert not table[:2, 3:].any() and not table[2:].any()
+    write_table(path, np.ones((3, 2)), 5, 2)  # another shape: the file is cut to it
+    np.testing.assert_array_equal(np.fromfile(path).reshape(5, 2), np.r_[np.ones((3, 2)), np.zeros((2, 2))])
