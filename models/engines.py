@@ -193,7 +193,18 @@ def integrate(
     types = np.broadcast_to(np.asarray(afferent_type, dtype=object), (n,))
     params = neuron_arrays(types, neuron_params)
     v, u = _initial_state(state, params["b"], n)
-    current = np.ascontiguousarray(current)
+    return run_checked(np.ascontiguousarray(current), substeps, dt, params, v, u, engine, method)
+
+
+def run_checked(current, substeps, dt, params, v, u, engine, method) -> SpikeResult:
+    """`integrate` on inputs already checked: the seam's engines, stability and spike checks.
+
+    ``current`` is a finite, C-contiguous float64 (n_samples, n) array in
+    mV/ms; ``params`` as `models.neuron.neuron_arrays` gives them; ``v`` and
+    ``u`` (mV) are updated in place to the final state.  For callers that
+    made their inputs themselves (`models.fused.FusedPlan.advance`).
+    """
+    n = current.shape[1]
     check_stability(current, dt, method)
     if n == 0 or current.shape[0] == 0:
         neuron = step = np.empty(0, np.int64)

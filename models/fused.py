@@ -37,7 +37,7 @@ from ._stage_kernels import filter_sections, receptor_noise_keyed, stage_tail, t
 from .attenuation import UNTUNED, profile_value
 from .currents import _stage_constants
 from .direct import _BLOCK, _METHOD_CODES, _integrate_range, integrate_parts, part_bounds, spike_checks
-from .engines import NeuronState, check_integration, check_stability, integrate, substeps_for
+from .engines import NeuronState, check_integration, check_stability, run_checked, substeps_for
 from .nap import get_profile, tip_radius
 from .neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
 from .rng import normal_row
@@ -411,16 +411,16 @@ class FusedPlan:
         in parallel; other engines get the currents.
         """
         started = sample0 > 0
-        if engine != "direct":
-            current = self.currents(forces, state, started, sample0, key)
-            res = integrate(current, fs=self.fs, dt=dt, afferent_type=self.afferent_type, engine=engine,
-                            method=method, state=neuron)
-            return res.afferent, res.step, res.state
         args = self._neuron_args(dt, method)
         if neuron is None:
             v, u = (np.array(x, dtype=float) for x in resting_state(args[5]))
         else:
             v, u = neuron.v.copy(), neuron.u.copy()
+        if engine != "direct":  # the plan's currents need no second check at the seam
+            params = dict(zip("abcd", args[4:8]))
+            res = run_checked(self.currents(forces, state, started, sample0, key), args[0], dt, params, v, u,
+                              engine, method)
+            return res.afferent, res.step, res.state
         current, afferent, step, lowest, finite, capped = self.spikes(forces, state, started, sample0, key, args, v,
                                                                      u, parts)
         if method != "euler":
