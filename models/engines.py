@@ -216,7 +216,7 @@ def run_checked(current, substeps, dt, params, v, u, engine, method) -> SpikeRes
         from .brian2_engine import run_brian2
 
         neuron, step = run_brian2(current, substeps, dt, params, v, u, method=method, v_peak=V_PEAK, v_floor=V_FLOOR)
-    check_integration(neuron, step, v, u, current, method, dt)
+    check_integration(neuron, step, v, u, current, method, dt, stacklevel=4)  # the warning names our caller's caller
     return SpikeResult(neuron, step, NeuronState(v, u), dt, current.shape[0] * substeps)
 
 
@@ -233,7 +233,7 @@ def check_stability(current, dt, method) -> None:
         )
 
 
-def check_integration(neuron, step, v, u, current, method, dt) -> None:
+def check_integration(neuron, step, v, u, current, method, dt, stacklevel=3) -> None:
     """Never hand back NaN (raise); warn when the one-spike-per-step cap bound."""
     if not (np.all(np.isfinite(v)) and np.all(np.isfinite(u))):
         bad = int(np.flatnonzero(~(np.isfinite(v) & np.isfinite(u)))[0])
@@ -253,4 +253,4 @@ def check_integration(neuron, step, v, u, current, method, dt) -> None:
             n_capped = np.unique(neuron[order][1:][consecutive]).size
             warnings.warn(SpikeCapWarning(
                 f"{n_capped} neuron(s) spiked on consecutive steps: the one-spike-per-step cap bound at "
-                f"dt={dt * 1e3:g} ms (rates up to {1.0 / dt:.0f} pulses/s); use a smaller dt"), stacklevel=3)
+                f"dt={dt * 1e3:g} ms (rates up to {1.0 / dt:.0f} pulses/s); use a smaller dt"), stacklevel=stacklevel)
