@@ -122,9 +122,13 @@ def _pad(n: int, quantum: int) -> int:
 def _key_dir(key: tuple) -> Path:
     brian2 = _import_brian2()
 
-    here = Path(__file__).parent
-    ours = [p.read_bytes() for p in (here / "_brian2_device.py", *sorted((here / "brian2_templates").glob("*.cpp")))]
-    text = repr((key, brian2.__version__, _COMPILE_ARGS, _TEMPLATE_VERSION, _ODE, _VARIABLES, _IZHIKEVICH_2003, _EULER_FLOORED, ours))
+    from . import _brian2_device as device
+
+    # What the project is generated from: our templates and C++ (not the module's prose).
+    ours = [p.read_bytes() for p in sorted((Path(__file__).parent / "brian2_templates").glob("*.cpp"))]
+    ours += [device._INPUT_CPP, device._PER_STEP, device._AFTER_LOOP, device._ONCE]
+    text = repr((key, brian2.__version__, _COMPILE_ARGS, _TEMPLATE_VERSION, _ODE, _VARIABLES, _IZHIKEVICH_2003,
+                 _EULER_FLOORED, ours))
     digest = hashlib.sha256(text.encode()).hexdigest()[:16]
     n_neurons, n_samples, substeps, dt, method = key
     return cache_dir() / f"n{n_neurons}_t{n_samples}_s{substeps}_{method}_{digest}"
@@ -209,6 +213,8 @@ def _build(key: tuple) -> _Build:
             flush=True,
         )
     with _brian2_prefs() as b2:
+        from ._brian2_device import input_function
+
         standalone = _device()
         standalone.reinit()  # forget the previously built project, if any
         # Brian2 names objects uniquely among those alive; once the previous
@@ -217,8 +223,6 @@ def _build(key: tuple) -> _Build:
         gc.collect()
         b2.set_device(standalone, directory=str(directory), build_on_run=False)
         fs = 1.0 / (dt * substeps)
-        from ._brian2_device import input_function
-
         ddmm_input = input_function(n_samples, n_neurons, fs)
         explicit = method in ("izhikevich2003", "euler")
         group = b2.NeuronGroup(

@@ -463,7 +463,8 @@ class FusedPlan:
         """Currents (mV/ms), shape (n_samples, n_afferents), of forces in newtons.
 
         ``forces`` is (n_samples, 3), felt by every afferent, or for a plan
-        with a ``mixing`` the site forces (n_samples, n_sites, 3).
+        with a ``mixing`` the site forces (n_samples, n_sites, 3); long inputs
+        run in slices of time of `_SLICE` elements, with the same result.
         ``state`` is updated in place; ``started`` is False on the first
         chunk, whose first sample is sample ``sample0`` of the scene.  With
         a stream ``key`` (`models.rng.stream_key`), the noise of sample n of
@@ -473,8 +474,9 @@ class FusedPlan:
         if n <= step:
             return self._current_slice(forces, state, started, sample0, key)
         out = np.empty((n, self.n_afferents))
-        for t0 in range(0, n, step):  # slices of time (contiguous rows of ``out``): each one's passes stay in cache
-            self._current_slice(forces[t0 : t0 + step], state, started or t0 > 0, sample0 + t0, key, out[t0 : t0 + step])
+        for t0 in range(0, n, step):  # slices of time, contiguous rows of ``out``: each one's passes stay in cache
+            rows = slice(t0, t0 + step)
+            self._current_slice(forces[rows], state, started or t0 > 0, sample0 + t0, key, out[rows])
         return out
 
     def _current_slice(self, forces, state, started, sample0, key, out=None):
