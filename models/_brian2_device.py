@@ -12,7 +12,6 @@ Imported only when a project is generated (it imports Brian2).  Measured on a
   process CPU clock after every time step, a system call (about 0.45 us,
   4.5 ms a block) that only feeds the run's reported duration.  The
   duration is read once after the loop instead.
-
 * **Current table** (`input_function`): read through a memory map of the
   run's file instead of a `TimedArray` copied into fresh memory on every
   run (system time 8 -> 3.6 ms a block).

@@ -32,6 +32,7 @@ _OWNER = [0]  # pid whose lanes _FREE and _MINE hold (a forked child starts afre
 _MINE: list = []
 _LOCK = threading.Lock()
 _MAPS: dict = {}  # table file -> its np.memmap (`write_table`)
+_KEEP_MAPPED = 1 << 22  # elements (32 MB): larger tables are unmapped after each write
 
 
 def _root() -> Path:
@@ -103,8 +104,9 @@ def write_table(path: Path, current, n_samples: int, n_neurons: int) -> None:
     The lane's file is written through a memory map kept from run to run:
     one strided copy into pages already mapped took about 0.9 ms for a
     hand block (1,000 x 3,146 into 3,168 columns), where padding a copy and
-    writing it to the file took 3-5 ms.  Padded neurons and samples are
-    zeros.
+    writing it to the file took 3-5 ms.  Tables of more than `_KEEP_MAPPED`
+    elements are unmapped after writing, so a lane holds at most 32 MB
+    mapped between runs.  Padded neurons and samples are zeros.
     """
     shape = (int(n_samples), int(n_neurons))
     table = _MAPS.get(path)
@@ -117,3 +119,5 @@ def write_table(path: Path, current, n_samples: int, n_neurons: int) -> None:
     table[:rows, :cols] = current
     table[:rows, cols:] = 0.0
     table[rows:] = 0.0
+    if table.size > _KEEP_MAPPED:  # a long run's table is not held in memory between runs
+        del _MAPS[path]

@@ -189,3 +189,15 @@ def test_brian2_table_is_padded_with_zeros_whatever_the_lane_held(tmp_path):
     assert not table[:2, 3:].any() and not table[2:].any()
     write_table(path, np.ones((3, 2)), 5, 2)  # another shape: the file is cut to it
     np.testing.assert_array_equal(np.fromfile(path).reshape(5, 2), np.r_[np.ones((3, 2)), np.zeros((2, 2))])
+
+
+def test_brian2_lanes_hold_only_small_tables_mapped(tmp_path, monkeypatch):
+    """Between runs a lane keeps a small table mapped (cheap to rewrite) but not a long run's."""
+    import models._brian2_lanes as lanes
+
+    monkeypatch.setattr(lanes, "_KEEP_MAPPED", 20)
+    small, large = tmp_path / "small.dat", tmp_path / "large.dat"
+    lanes.write_table(small, np.ones((4, 5)), 4, 5)
+    lanes.write_table(large, np.ones((4, 6)), 4, 6)
+    assert small in lanes._MAPS and large not in lanes._MAPS
+    np.testing.assert_array_equal(np.fromfile(large), np.ones(24))
