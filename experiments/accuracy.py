@@ -3,8 +3,8 @@
 Workload: the fingertip preset with both its noises switched off (so every run is
 deterministic and comparable), on the Birznieks scene in 8 directions
 (0, 45, ..., 315 deg).  Each (dt, method, engine) run goes through the whole
-`population.simulate` pipeline and is compared with the reference solver
-(`models.reference`, RK4 at 5 us with exact threshold crossings, itself
+`ddmm.population.simulate` pipeline and is compared with the reference solver
+(`ddmm.models.reference_solver`, RK4 at 5 us with exact threshold crossings, itself
 checked against `scipy.integrate.solve_ivp`):
 
 * ``sf_err_mean``, ``sf_err_max``: |SF - SF_ref| over afferent-conditions,
@@ -27,13 +27,13 @@ import time
 
 import numpy as np
 
-from models.engines import NumericalInstabilityError
-from models.metrics import CONTACT_THRESHOLD, direction_index
-from models.neuron import neuron_arrays, resting_state
-from models.reference import reference_spike_times
-from population import birznieks, load_spec, sample_population, simulate
-from population.decode import angular_error, population_vector
-from population.simulate import population_currents
+from ddmm.models.engines import NumericalInstabilityError
+from ddmm.models.metrics import CONTACT_THRESHOLD, direction_index
+from ddmm.models.neuron import neuron_arrays, resting_state
+from ddmm.models.reference_solver import reference_spike_times
+from ddmm.population import birznieks, load_spec, sample_population, simulate
+from ddmm.population.analysis.decode import angular_error, population_vector
+from ddmm.population.simulation import population_currents
 
 __all__ = ["DTS_MS", "METHODS", "DIRECTIONS", "REF_DT", "workload", "reference_times", "measure", "run_accuracy",
            "tolerance_table"]
@@ -163,8 +163,8 @@ def unseen_workload_check(tolerances=(0.3, 0.5, 1.0, 2.0, 5.0)) -> list:
     theta_R = 60 deg (seed 4, every 40th).  Returns one row per tolerance: the choice and the
     mean SF error (pulses/s) on each workload.
     """
-    from population import press_push_lift, rotating_shear
-    from population.accuracy import choose_setting
+    from ddmm.population import press_push_lift, rotating_shear
+    from ddmm.population.runtime.step_choice import choose_setting
 
     rot = workload("fingertip", seed=3, directions=(30.0, 200.0),
                    scene=lambda d: dataclasses.replace(rotating_shear(start_deg=d), name=f"rot{d:g}"))

@@ -1,7 +1,7 @@
 """Torque and slip decoding: the protocols behind ``ddmm decode --task torque|slip``.
 
-**Torque** (after Loutit et al., PHYSIOLOGY.md row 18): torsion scenes
-(`population.site_scenes.torsion`) of 3.5, 5.5 and 7.5 mNm, clockwise and
+**Torque** (after Loutit et al., docs/references.md row 18): torsion scenes
+(`ddmm.population.stimuli.site_scenes.torsion`) of 3.5, 5.5 and 7.5 mNm, clockwise and
 anticlockwise, on 2 and 4 N of normal force, on the fingertip.  Spike counts
 in a window after torque onset feed a `CentroidClassifier` trained on half
 the trials (independent noise draws) and tested on the other half, for
@@ -25,9 +25,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from population import load_spec, sample_population, simulate
-from population.array_decode import CentroidClassifier, SlipDetector, evaluate_slip, onset_counts, stage_onset
-from population.site_scenes import incipient_slip, torsion
+from ddmm.population import load_spec, sample_population, simulate
+from ddmm.population.analysis.array_decode import (
+    CentroidClassifier,
+    SlipDetector,
+    evaluate_slip,
+    onset_counts,
+    stage_onset,
+)
+from ddmm.population.stimuli.site_scenes import incipient_slip, torsion
 
 __all__ = ["TORQUES_MNM", "NORMALS_N", "SLIP_RATES_N_S", "HUMAN_SLIP_RESPONSE_MS", "torque_scenes", "slip_scenes",
            "run_torque", "run_slip"]

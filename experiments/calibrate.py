@@ -17,7 +17,7 @@ Fitted (per type, SA-I and FA-I, to Birznieks et al. 2001 as the paper reports i
 **Constrained** (a penalty in the objective, checked on the fitted type): rest
 silence, the on/off response (hold rate, adaptation, release), and rates below
 500 pulses/s with no spike on consecutive steps on every shipped scene:
-scorecard properties 1-3 (`population.physiology`).
+scorecard properties 1-3 (`ddmm.population.analysis.physiology`).
 
 **Fixed, not fitted** (values in the presets, reasons in docs/model.md): the
 stage structure and time constants; selective and broad share the tuned
@@ -40,12 +40,11 @@ import json
 import numpy as np
 from scipy.optimize import minimize
 
-from models.currents import AFFERENT_TYPES
-from population import load_spec, sample_population, simulate
-from population.physiology import PROPERTIES, score_physiology
-from population.tuning import DEFAULT_TRIALS, direction_tuning, tuning_scenes, tuning_summary
-
-from .reference import HUMAN_DSI, HUMAN_TUNED_FRACTION, PHYSIOLOGY_REFERENCE
+from ddmm.experiments.paper_values import HUMAN_DSI, HUMAN_TUNED_FRACTION, PHYSIOLOGY_REFERENCE
+from ddmm.models.currents import AFFERENT_TYPES
+from ddmm.population import load_spec, sample_population, simulate
+from ddmm.population.analysis.physiology import PROPERTIES, score_physiology
+from ddmm.population.analysis.tuning import DEFAULT_TRIALS, direction_tuning, tuning_scenes, tuning_summary
 
 __all__ = ["TARGETS", "FIT_SEEDS", "VALIDATION_SEEDS", "CONSTRAINTS", "apply_parameters", "type_statistics",
            "constraint_penalty", "fit_type", "validate", "calibrate", "spec_to_toml"]
@@ -55,7 +54,7 @@ TARGETS = {kind: {"tuned": HUMAN_TUNED_FRACTION[kind], "dsi_mean": HUMAN_DSI[kin
 #: Population seeds pooled during the fit, and the five held-out seeds of the check.
 FIT_SEEDS = (1000, 1001, 1002)
 VALIDATION_SEEDS = (0, 1, 2, 3, 4)
-#: Scorecard protocols whose properties constrain the fit (properties 1-3 of issue 9).
+#: Scorecard protocols whose properties constrain the fit (docs/references.md, checks 1-3).
 CONSTRAINTS = ("rest", "on_off", "rates")
 _TOLERANCE = {"tuned": 0.02, "dsi_mean": 0.015, "dsi_sd": 0.025}
 _SAI_ON_CURRENT = 18.0  # mV/ms at 4 N aligned: ~40 pulses/s before adaptation
@@ -211,7 +210,7 @@ def _count_toml(t) -> list:
 
 
 def spec_to_toml(spec, header: str = "") -> str:
-    """TOML text of a spec (the layout `population.spec` reads)."""
+    """TOML text of a spec (the layout `ddmm.population.spec` reads)."""
     lines = [header.rstrip(), f"name = {_toml_value(spec.name)}", f"description = {_toml_value(spec.description)}",
              "", *_where_toml(spec), "", "[current]"]
     for f in dataclasses.fields(spec.current):

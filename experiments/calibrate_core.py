@@ -9,13 +9,13 @@ and Fig. 8 is then a *prediction* of the calibrated model.
 
 Run::
 
-    python -m experiments.calibrate_core [--out calibration.json] [--transducer-scan]
+    python -m ddmm.experiments.calibrate_core [--out calibration.json] [--transducer-scan]
 
 ``--transducer-scan`` refits the gains for each compressive transducer scale
 ``i_sat`` and cut-off and reports, for each, whether the issue's Table II/III
 checks hold and the peak 10-ms firing rates on both scenes (docs/model.md).
 
-The fitted values are committed as the defaults of `models.CurrentParams`.
+The fitted values are committed as the defaults of `ddmm.models.CurrentParams`.
 """
 
 from __future__ import annotations
@@ -27,14 +27,13 @@ import json
 import numpy as np
 from scipy.optimize import brentq
 
-from models.currents import PAPER_TYPES, CurrentParams
-from models.engines import integrate, substeps_for
-from models.metrics import spiking_frequency
-from models.pipeline import compute_currents
-from population.scenes import birznieks, press_push_lift
-
-from .reference import PAPER_TABLE3
-from .reproduce import ReproConfig, reproduce_all
+from ddmm.experiments.paper_values import PAPER_TABLE3
+from ddmm.experiments.reproduce import ReproConfig, reproduce_all
+from ddmm.models.currents import PAPER_TYPES, CurrentParams
+from ddmm.models.engines import integrate, substeps_for
+from ddmm.models.metrics import spiking_frequency
+from ddmm.models.pipeline import compute_currents
+from ddmm.population.stimuli.scenes import birznieks, press_push_lift
 
 __all__ = ["CMM_TARGETS", "cmm_sf", "fit_gains", "cutoff_effect", "transducer_scan", "main"]
 

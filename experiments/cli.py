@@ -17,13 +17,23 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand registered."""
-    from . import (bench, cmd_accuracy, cmd_biology, cmd_export, cmd_physiology, cmd_population, cmd_reproduce,
-                   cmd_stream)
+    from ddmm import __version__
+    from ddmm.experiments import (
+        bench,
+        cmd_accuracy,
+        cmd_biology,
+        cmd_export,
+        cmd_physiology,
+        cmd_population,
+        cmd_reproduce,
+        cmd_stream,
+    )
 
     parser = _Parser(
         prog="ddmm",
         description="Population-coding simulator of tactile afferents (DDMM).",
     )
+    parser.add_argument("--version", action="version", version=f"ddmm {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                 parser_class=_Parser)
     for module in (cmd_reproduce, cmd_population, cmd_biology, cmd_physiology, cmd_accuracy, cmd_stream, cmd_export,
@@ -34,7 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     """Entry point of the ``ddmm`` console script."""
-    from population._extras import MissingExtraError
+    from ddmm.population._extras import MissingExtraError
 
     args = build_parser().parse_args(argv)
     try:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from importlib import resources
 
-from .io import ensure_out_dir, save_figure, save_json
+from ddmm.experiments.io import ensure_out_dir, save_figure, save_json
 
 __all__ = ["register", "format_rows"]
 
@@ -43,10 +43,9 @@ def _split(text, cast=str):
 
 
 def run(args) -> int:
-    from models._validation import check_choice
-    from models.engines import ENGINES, METHODS
-
-    from .accuracy import DTS_MS, run_accuracy, tolerance_table
+    from ddmm.experiments.accuracy import DTS_MS, run_accuracy, tolerance_table
+    from ddmm.models._validation import check_choice
+    from ddmm.models.engines import ENGINES, METHODS
 
     engines, methods = _split(args.engines), _split(args.methods) or METHODS
     for e in engines:
@@ -61,12 +60,12 @@ def run(args) -> int:
               "workload": result["workload"]}
     print(json.dumps(shaped) if args.json else format_rows(result["rows"]))
     if out_dir is not None:
-        from .plotting import plot_pareto
+        from ddmm.experiments.plotting import plot_pareto
 
         save_json(shaped, out_dir / "accuracy.json")
         save_figure(plot_pareto(result["rows"]), out_dir / "pareto.png")
     if args.write_table:
-        path = resources.files("population").joinpath("data", "accuracy_table.json")
+        path = resources.files("ddmm.population").joinpath("data", "accuracy_table.json")
         save_json({"rows": tolerance_table(result), "workload": result["workload"],
                    "written_by": "ddmm accuracy --write-table"}, path)
     return 0

@@ -5,10 +5,11 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-TUNING_TRIALS = 5  # population.tuning.DEFAULT_TRIALS, repeated so that registering the parser imports nothing heavy
+TUNING_TRIALS = 5  # ddmm.population.analysis.tuning.DEFAULT_TRIALS, repeated so that registering the parser imports nothing heavy
 
-from .io import atomic_write, ensure_out_dir, save_figure, save_json
-from .reference import HUMAN_DIRECTION_THRESHOLD_DEG, HUMAN_DSI, HUMAN_TUNED_FRACTION
+from ddmm.experiments.io import atomic_write, ensure_out_dir, save_figure, save_json
+from ddmm.experiments.paper_values import HUMAN_DIRECTION_THRESHOLD_DEG, HUMAN_DSI, HUMAN_TUNED_FRACTION
+from ddmm.models.currents import type_label
 
 __all__ = ["register", "TUNING_REFERENCE", "run_tuning_stats", "decode_summary"]
 
@@ -40,7 +41,7 @@ def register(sub) -> None:
     p.add_argument("--out", metavar="DIR", help="write calibrate.json and calibrated_{fingertip,hand}.toml here")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=run_calibrate)
-    p = sub.add_parser("decode", help="decode shear direction (vs 7.1 deg), torque or slip from population spikes")
+    p = sub.add_parser("decode", help="decode shear direction (vs 7.1 deg), torque or slip from ddmm.population spikes")
     p.add_argument("--task", choices=("direction", "torque", "slip"), default="direction",
                    help="direction (default), torque (torsion scenes) or slip (incipient-slip scenes)")
     p.add_argument("--trials", type=int, default=20, help="torque and slip: trials per condition, half for training")
@@ -57,8 +58,8 @@ def register(sub) -> None:
 
 def run_tuning_stats(population="fingertip", seed=0, trials=TUNING_TRIALS, engine="direct", correction="none"):
     """Simulate the five-condition protocol and return (tuning dataset, summary)."""
-    from population import load_spec, sample_population, simulate
-    from population.tuning import direction_tuning, tuning_scenes, tuning_summary
+    from ddmm.population import load_spec, sample_population, simulate
+    from ddmm.population.analysis.tuning import direction_tuning, tuning_scenes, tuning_summary
 
     pop = sample_population(load_spec(population), rng=seed)
     ds = simulate(pop, tuning_scenes(), engine=engine, trials=trials, seed=seed, quiet=True)
@@ -87,11 +88,11 @@ def run_tuning(args) -> int:
             ref_f = TUNING_REFERENCE["tuned_fraction"][kind]
             d = summary["dsi"].get(kind)
             ref_d = TUNING_REFERENCE["dsi"].get(kind, "")
-            print(f"| {kind} | {_fmt(summary['tuned_fraction'][kind], True)} | {_fmt(ref_f, True)} | "
+            print(f"| {type_label(kind)} | {_fmt(summary['tuned_fraction'][kind], True)} | {_fmt(ref_f, True)} | "
                   + (f"{d['mean']:.2f} ± {d['sd']:.2f}" if isinstance(d, dict) else (d or ""))
                   + " | " + (f"{ref_d['mean']} ± {ref_d['sd']}" if isinstance(ref_d, dict) else str(ref_d)) + " |")
     if out_dir is not None:
-        from .plotting import plot_dsi_histograms, plot_preferred_rose
+        from ddmm.experiments.plotting import plot_dsi_histograms, plot_preferred_rose
 
         save_json(result, out_dir / "tuning.json")
         save_figure(plot_dsi_histograms(tuning, HUMAN_DSI), out_dir / "dsi_histograms.png")
@@ -100,7 +101,7 @@ def run_tuning(args) -> int:
 
 
 def run_calibrate(args) -> int:
-    from .calibrate import adopt, calibrate, spec_to_toml
+    from ddmm.experiments.calibrate import adopt, calibrate, spec_to_toml
 
     out_dir = ensure_out_dir(args.out) if args.out else None
     spec, report = calibrate()
@@ -120,7 +121,7 @@ def run_calibrate(args) -> int:
 
 def decode_summary(population="fingertip", seed=0, train=200, test=200, subsets=10, engine="direct"):
     """Run the decoding protocol; returns (summary dict, best settings)."""
-    from .decoding import best_settings, run_decoding, summarise
+    from ddmm.experiments.decoding import best_settings, run_decoding, summarise
 
     for name, value in (("--train", train), ("--test", test), ("--subsets", subsets)):
         if value < 1:
@@ -149,7 +150,7 @@ def run_decode(args) -> int:
             print()
         print(f"human threshold {HUMAN_DIRECTION_THRESHOLD_DEG} deg; reached first by: {json.dumps(best)}")
     if out_dir is not None:
-        from .plotting import plot_neurometric
+        from ddmm.experiments.plotting import plot_neurometric
 
         save_json({**summary, "best": best}, out_dir / "decode.json")
         save_figure(plot_neurometric(summary, HUMAN_DIRECTION_THRESHOLD_DEG), out_dir / "neurometric.png")
@@ -157,8 +158,8 @@ def run_decode(args) -> int:
 
 
 def _run_array_task(args) -> int:
-    """``ddmm decode --task torque|slip``: the protocols of `experiments.array_tasks`."""
-    from .array_tasks import run_slip, run_torque
+    """``ddmm decode --task torque|slip``: the protocols of `ddmm.experiments.array_tasks`."""
+    from ddmm.experiments.array_tasks import run_slip, run_torque
 
     if args.trials < 2:
         raise ValueError(f"--trials must be >= 2 (half train, half test), got {args.trials}")
@@ -173,7 +174,7 @@ def _run_array_task(args) -> int:
         print("| window (ms) | types | n | accuracy | " + " | ".join(extra) + " |\n" + "|---" * (4 + len(extra)) + "|")
         for r in result["results"]:
             values = ["-" if r[k] is None else f"{r[k]:.3g}" for k in extra]
-            print(f"| {r['window_ms']} | {'+'.join(r['types'])} | {r['n_afferents']} | {r['accuracy']:.3f} | "
+            print(f"| {r['window_ms']} | {'+'.join(type_label(t) for t in r['types'])} | {r['n_afferents']} | {r['accuracy']:.3f} | "
                   + " | ".join(values) + " |")
     if out_dir is not None:
         save_json(result, out_dir / f"decode_{args.task}.json")

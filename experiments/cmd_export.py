@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .cmd_population import check_out_file
+from ddmm.experiments.cmd_population import check_out_file
 
 __all__ = ["register", "run_export"]
 
@@ -11,15 +11,15 @@ def register(sub) -> None:
     """Add ``ddmm export``."""
     p = sub.add_parser("export", help="write a dataset (.nc) as an NWB file (needs the [nwb] extra)",
                        description="Export a dataset of 'ddmm simulate' to NWB: afferents as units, (condition, "
-                                   "trial) pairs as trials on one session clock, the forces as stimulus "
-                                   "(layout: population/nwb.py).")
+                                   "trial) pairs as trials on one clock, the forces as stimulus "
+                                   "(layout: ddmm.population.io.nwb).")
     p.add_argument("file", metavar="FILE.nc", help="dataset written by 'ddmm simulate'")
     p.add_argument("--nwb", required=True, metavar="OUT.nwb", help="NWB file to write (replaced atomically)")
     p.set_defaults(func=run_export)
 
 
 def run_export(args) -> int:
-    from population import load_dataset, to_nwb
+    from ddmm.population import load_dataset, to_nwb
 
     out = check_out_file(args.nwb, ".nwb", "--nwb")
     ds = load_dataset(args.file)

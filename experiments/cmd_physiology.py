@@ -5,9 +5,9 @@ from __future__ import annotations
 import json
 import math
 
-
-from .io import ensure_out_dir, save_figure, save_json
-from .reference import HUMAN_DSI
+from ddmm.experiments.io import ensure_out_dir, save_figure, save_json
+from ddmm.experiments.paper_values import HUMAN_DSI
+from ddmm.models.currents import type_label
 
 __all__ = ["register", "run_scorecard", "scorecard_json"]
 
@@ -27,10 +27,9 @@ def register(sub) -> None:
 
 def run_scorecard(population="fingertip", seed=0, properties=None, engine="direct"):
     """Sample the population and score it; returns (rows, protocol data)."""
-    from population import load_spec, sample_population
-    from population.physiology import score_physiology
-
-    from .reference import PHYSIOLOGY_REFERENCE
+    from ddmm.experiments.paper_values import PHYSIOLOGY_REFERENCE
+    from ddmm.population import load_spec, sample_population
+    from ddmm.population.analysis.physiology import score_physiology
 
     pop = sample_population(load_spec(population), rng=seed)
     return score_physiology(pop, PHYSIOLOGY_REFERENCE, properties=properties, seed=seed, engine=engine)
@@ -45,6 +44,14 @@ def scorecard_json(rows) -> dict:
     keys = ("name", "type", "protocol", "statistic", "unit", "value", "low", "high", "source", "role", "mark", "pass")
     props = [{k: (_finite(r[k]) if k in ("value", "low", "high") else r[k]) for k in keys} for r in rows]
     return {"properties": props, "all_pass": all(r["pass"] for r in rows)}
+
+
+def _type(code) -> str:
+    """A row's type as displayed: FA-I for RAI, ... (rows of several types keep their text)."""
+    try:
+        return type_label(code)
+    except ValueError:
+        return str(code)
 
 
 def _bound(row):
@@ -65,14 +72,14 @@ def run_physiology(args) -> int:
         print("| property | type | protocol | statistic | model | reference | role | pass | source |")
         print("|---|---|---|---|---|---|---|---|---|")
         for r in rows:
-            print(f"| {r['name']} | {r['type']} | {r['protocol']} | {r['statistic']} | {r['value']:.4g} "
+            print(f"| {r['name']} | {_type(r['type'])} | {r['protocol']} | {r['statistic']} | {r['value']:.4g} "
                   f"{'' if r['unit'] == '1' else r['unit']} | {_bound(r)} ({r['mark']}) | {r['role']} | "
                   f"{'pass' if r['pass'] else 'FAIL'} | {r['source']} |")
-        from population.physiology import summarise_scorecard
+        from ddmm.population.analysis.physiology import summarise_scorecard
 
         print("\n" + summarise_scorecard(rows))
     if out_dir is not None:
-        from .plot_physiology import physiology_figures
+        from ddmm.experiments.plot_physiology import physiology_figures
 
         save_json(result, out_dir / "scorecard.json")
         for name, fig in physiology_figures(data, HUMAN_DSI).items():

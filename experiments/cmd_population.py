@@ -6,9 +6,8 @@ import time
 import warnings
 from pathlib import Path
 
-from population.arrays import EXTENSIONS
-
-from .io import ensure_out_dir, save_figure
+from ddmm.experiments.io import ensure_out_dir, save_figure
+from ddmm.population.io.arrays import EXTENSIONS
 
 __all__ = ["check_out_file", "register", "register_demo", "scenes_from_args", "write_plots"]
 
@@ -77,7 +76,7 @@ def _directions(text, default="90"):
 
 
 def _contact(text):
-    from population import Contact
+    from ddmm.population import Contact
     if text is None:
         return None
     try:
@@ -89,7 +88,7 @@ def _contact(text):
 
 def _array_scene(args):
     """The sensor-array scene of ``--scene FILE`` (and ``--sites``), or None for any other ``--scene``."""
-    from population import from_array, from_long_csv
+    from ddmm.population import from_array, from_long_csv
     suffix = Path(args.scene).suffix.lower()
     is_array = suffix in EXTENSIONS or (suffix == ".csv" and args.sites is not None)
     if args.sites is not None and suffix != ".csv":
@@ -105,7 +104,7 @@ def _array_scene(args):
 
 def scenes_from_args(args) -> list:
     """The scenes named by ``--scene``, ``--sites``, ``--theta-r`` and ``--contact``."""
-    from population import birznieks, from_csv, press_push_lift, rotating_shear
+    from ddmm.population import birznieks, from_csv, press_push_lift, rotating_shear
     array = _array_scene(args)
     if array is not None:
         return [array]
@@ -131,7 +130,7 @@ def _types(text):
 
 
 def _population(args):
-    from population import load_spec, sample_population
+    from ddmm.population import load_spec, sample_population
     return sample_population(load_spec(args.population), rng=args.seed)
 
 
@@ -154,7 +153,7 @@ def check_out_file(path, suffix: str = ".nc", option: str = "--out") -> Path:
 
 
 def run_simulate(args) -> int:
-    from population import save_dataset, simulate
+    from ddmm.population import save_dataset, simulate
     out = check_out_file(args.out)
     pop, scenes = _population(args), scenes_from_args(args)
     start = time.perf_counter()
@@ -170,13 +169,13 @@ def run_simulate(args) -> int:
 
 
 def run_plan(args) -> int:
-    from population import plan_run
+    from ddmm.population import plan_run
     pop, scenes = _population(args), scenes_from_args(args)
     the_plan = plan_run(pop, scenes, trials=args.trials, no_shear=args.no_shear, types=_types(args.types),
                         engine=args.engine, scheduler=args.scheduler)
     print(the_plan.describe(pop, scenes))
     if args.tolerance is not None:
-        from population.accuracy import choose_setting
+        from ddmm.population.runtime.step_choice import choose_setting
 
         row = choose_setting(args.tolerance, scenes[0].fs)
         print(f"tolerance {args.tolerance:g} pulses/s: dt={row['dt_ms']:g} ms, method={row['method']} "
@@ -185,29 +184,34 @@ def run_plan(args) -> int:
 
 
 def run_info(args) -> int:
-    from population import describe_dataset, load_dataset
+    from ddmm.population import describe_dataset, load_dataset
     print(describe_dataset(load_dataset(args.file)))
     return 0
 
 
 def write_plots(ds, out_dir) -> list:
     """Write the standard figures of a dataset (plus ``hand.png`` when it has hand-map regions); returns the paths."""
-    from population import psth
-    from .plotting import plot_forces, plot_polar_counts, plot_psth, plot_raster  # matplotlib is slow to import
+    from ddmm.experiments.plotting import (  # matplotlib is slow to import
+        plot_forces,
+        plot_polar_counts,
+        plot_psth,
+        plot_raster,
+    )
+    from ddmm.population import psth
 
     out_dir = ensure_out_dir(out_dir)
     bin_s = max(0.005, float(ds.duration.max()) / 100.0)
     figures = {"raster.png": plot_raster(ds), "psth.png": plot_psth(psth(ds, bin_s)),
                "polar.png": plot_polar_counts(ds), "forces.png": plot_forces(ds)}
     if "region" in ds.coords and any(ds.region.values.astype(str) != ""):  # afferents placed on the hand map
-        from .plot_hand import hand_counts, plot_hand
+        from ddmm.experiments.plot_hand import hand_counts, plot_hand
 
         figures["hand.png"] = plot_hand(ds, counts=hand_counts(ds))
     return [str(save_figure(fig, out_dir / name)) for name, fig in figures.items()]
 
 
 def run_plot(args) -> int:
-    from population import load_dataset
+    from ddmm.population import load_dataset
     for path in write_plots(load_dataset(args.file), args.out):
         print(f"wrote {path}")
     return 0
@@ -224,8 +228,8 @@ def register_demo(sub) -> None:
 
 
 def run_demo(args) -> int:
-    from models.engines import SpikeCapWarning
-    from population import describe_dataset, load_spec, press_push_lift, sample_population, save_dataset, simulate
+    from ddmm.models.engines import SpikeCapWarning
+    from ddmm.population import describe_dataset, load_spec, press_push_lift, sample_population, save_dataset, simulate
     out_dir = ensure_out_dir(args.out)
     pop = sample_population(load_spec("fingertip"), rng=args.seed)
     scene = press_push_lift(90.0)
@@ -252,14 +256,12 @@ def run_demo(args) -> int:
 
 def _demo_biology(args, out_dir) -> list:
     """Tuned fraction against 86% and decoding error against 7.1 deg, with what each supports."""
-    from .cmd_biology import run_tuning_stats
-    from .decoding import best_settings, run_decoding, summarise
-    from .plotting import plot_dsi_histograms, plot_neurometric, plot_preferred_rose
-    from .reference import HUMAN_DIRECTION_THRESHOLD_DEG, HUMAN_DSI, HUMAN_TUNED_FRACTION
-
-    from population.physiology import summarise_scorecard
-
-    from .cmd_physiology import run_scorecard
+    from ddmm.experiments.cmd_biology import run_tuning_stats
+    from ddmm.experiments.cmd_physiology import run_scorecard
+    from ddmm.experiments.decoding import best_settings, run_decoding, summarise
+    from ddmm.experiments.paper_values import HUMAN_DIRECTION_THRESHOLD_DEG, HUMAN_DSI, HUMAN_TUNED_FRACTION
+    from ddmm.experiments.plotting import plot_dsi_histograms, plot_neurometric, plot_preferred_rose
+    from ddmm.population.analysis.physiology import summarise_scorecard
 
     # The battery compiles a Brian2 project per protocol shape (minutes on a fresh machine); the
     # engines give identical spikes (tests hold them to it), so the summary uses the direct one.

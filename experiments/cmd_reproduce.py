@@ -6,9 +6,8 @@ import json
 import sys
 import warnings
 
-
-from .io import ensure_out_dir, save_figure, save_json
-from .reference import PAPER_TABLE2, PAPER_TABLE3
+from ddmm.experiments.io import ensure_out_dir, save_figure, save_json
+from ddmm.experiments.paper_values import PAPER_TABLE2, PAPER_TABLE3
 
 __all__ = ["register", "format_table2", "format_table3", "format_fig8"]
 
@@ -29,8 +28,8 @@ def register(sub) -> None:
 
 def format_table2(result: dict) -> str:
     """Markdown table of our PRSI beside the paper's."""
-    from models.currents import PAPER_TYPES
-    from .reproduce import PROFILES
+    from ddmm.experiments.reproduce import PROFILES
+    from ddmm.models.currents import PAPER_TYPES
     prsi = result["prsi"]
     lines = ["| type | " + " | ".join(f"{p} ours (paper)" for p in PROFILES) + " | human DSI |",
              "|---" * (len(PROFILES) + 2) + "|"]
@@ -42,8 +41,8 @@ def format_table2(result: dict) -> str:
 
 def format_table3(result: dict) -> str:
     """Markdown table of our SF at 75/255 deg beside the paper's."""
-    from models.currents import PAPER_TYPES
-    from .reproduce import PROFILES
+    from ddmm.experiments.reproduce import PROFILES
+    from ddmm.models.currents import PAPER_TYPES
     sf = result["sf"]
     lines = ["| type | " + " | ".join(f"{p} 75° / 255° ours (paper)" for p in PROFILES) + " |",
              "|---" * (len(PROFILES) + 1) + "|"]
@@ -59,8 +58,8 @@ def format_table3(result: dict) -> str:
 
 def format_fig8(result: dict) -> str:
     """Markdown summary of Fig. 8: peak angle, range and bipolar symmetry."""
-    from models.currents import PAPER_TYPES
-    from .reproduce import PROFILES
+    from ddmm.experiments.reproduce import PROFILES
+    from ddmm.models.currents import PAPER_TYPES
     sf = result["sf"]
     lines = ["| profile | type | peak theta_T | SF min-max (pulses/s) | SF(θ) = SF(θ+180°) |",
              "|---|---|---|---|---|"]
@@ -75,8 +74,8 @@ def format_fig8(result: dict) -> str:
 
 
 def _write_figures(out_dir, what, config, result) -> list[str]:
-    from .reproduce import FIGURE_SCENES, PROFILES, response_data
-    from .plotting import plot_response, plot_sf_vs_theta  # matplotlib is slow to import
+    from ddmm.experiments.plotting import plot_response, plot_sf_vs_theta  # matplotlib is slow to import
+    from ddmm.experiments.reproduce import FIGURE_SCENES, PROFILES, response_data
 
     written = []
     if what in ("fig8", "all"):
@@ -94,8 +93,8 @@ def _write_figures(out_dir, what, config, result) -> list[str]:
 
 
 def run(args) -> int:
-    from models.engines import SpikeCapWarning
-    from .reproduce import ReproConfig, fig8, reproduce_all, table2, table3
+    from ddmm.experiments.reproduce import ReproConfig, fig8, reproduce_all, table2, table3
+    from ddmm.models.engines import SpikeCapWarning
     config = ReproConfig(engine=args.engine, no_shear=args.no_shear)
     out_dir = ensure_out_dir(args.out) if args.out else None
     compute = {"table2": table2, "table3": table3, "fig8": fig8, "all": reproduce_all}[args.what]

@@ -60,8 +60,8 @@ def stream(encoder, lines, out, err) -> int:
 
 
 def run(args) -> int:
-    from population import load_spec, sample_population
-    from population.stream import Encoder
+    from ddmm.population import load_spec, sample_population
+    from ddmm.population.runtime.stream import Encoder
 
     encoder = Encoder(sample_population(load_spec(args.population), rng=args.seed), args.fs, dt=args.dt * 1e-3,
                       engine=args.engine, seed=args.seed)

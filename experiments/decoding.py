@@ -17,10 +17,9 @@ import dataclasses
 
 import numpy as np
 
-from population import birznieks, sample_population, simulate
-from population.decode import DECODERS, angular_error, select_afferents
-
-from .reference import HUMAN_DIRECTION_THRESHOLD_DEG
+from ddmm.experiments.paper_values import HUMAN_DIRECTION_THRESHOLD_DEG
+from ddmm.population import birznieks, sample_population, simulate
+from ddmm.population.analysis.decode import DECODERS, angular_error, select_afferents
 
 __all__ = ["SIZES", "WINDOWS_MS", "REFERENCE", "decoding_scenes", "run_decoding", "summarise"]
 

@@ -1,6 +1,6 @@
 """Generate the reference pages ``docs/cli.md`` and ``docs/api.md`` from the code, so they cannot drift.
 
-``python -m experiments.docs_reference [DIR]`` rewrites both pages (default
+``python -m ddmm.experiments.docs_reference [DIR]`` rewrites both pages (default
 ``docs/``); ``tests/test_docs.py`` fails when a committed page differs from
 what this module generates.
 """
@@ -18,7 +18,7 @@ from pathlib import Path
 __all__ = ["cli_reference", "api_reference", "write_references"]
 
 _WIDTH = "100"  # argparse wraps help at $COLUMNS: fixed, so the page is the same on every terminal
-_PACKAGES = ("models", "population")
+_PACKAGES = ("ddmm.models", "ddmm.population")
 
 
 @contextmanager
@@ -42,13 +42,13 @@ def cli_reference() -> str:
     >>> "## ddmm simulate" in cli_reference()
     True
     """
-    from .cli import build_parser
+    from ddmm.experiments.cli import build_parser
 
     with _columns():
         parser = build_parser()
         sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
         parts = ["# Command-line reference", "",
-                 "Generated from the argument parsers by `python -m experiments.docs_reference`; "
+                 "Generated from the argument parsers by `python -m ddmm.experiments.docs_reference`; "
                  "a test fails when this page and the parsers disagree.", "",
                  "```text", parser.format_help().rstrip(), "```", ""]
         for name, command in sub.choices.items():
@@ -57,10 +57,11 @@ def cli_reference() -> str:
 
 
 def _public_modules(package: str) -> list:
-    """The package, then its public submodules (no leading underscore), by name."""
+    """The package, then its public submodules and subpackages at any depth (no leading underscore), by name."""
     pkg = importlib.import_module(package)
-    names = sorted(m.name for m in pkgutil.iter_modules(pkg.__path__) if not m.name.startswith("_"))
-    return [pkg] + [importlib.import_module(f"{package}.{name}") for name in names]
+    names = sorted(m.name for m in pkgutil.walk_packages(pkg.__path__, prefix=f"{package}.")
+                   if not any(part.startswith("_") for part in m.name.split(".")))
+    return [pkg] + [importlib.import_module(name) for name in names]
 
 
 def _summary(obj) -> str:
@@ -103,21 +104,22 @@ def api_reference() -> str:
 
     Examples
     --------
-    >>> "`population.stream`" in api_reference()
+    >>> "`ddmm.population.runtime.stream`" in api_reference()
     True
     """
     parts = ["# API reference", "",
-             "Every public module of `models` (single-afferent physics) and `population` (populations, "
-             "scenes, simulation, datasets, analysis), with the names it exports. Generated from the "
-             "docstrings by `python -m experiments.docs_reference`; the docstrings themselves (numpydoc, "
-             "with examples that the tests run) are the full reference: `help(population.simulate)`.", ""]
+             "Every public module of `ddmm.models` (single-afferent physics and engines) and `ddmm.population` "
+             "(specs, sampling, simulation, datasets, and the anatomy, stimuli, runtime, analysis and io "
+             "subpackages), with the names it exports. Generated from the "
+             "docstrings by `python -m ddmm.experiments.docs_reference`; the docstrings themselves (numpydoc, "
+             "with examples that the tests run) are the full reference: `help(ddmm.population.simulate)`.", ""]
     for package in _PACKAGES:
         for module in _public_modules(package):
             exported = list(getattr(module, "__all__", []))
-            if not exported:
-                continue
             parts += [f"## `{module.__name__}`", "", _summary(module), ""]
-            parts += [_entry(module, name) for name in exported] + [""]
+            if hasattr(module, "__path__") and module.__name__ not in _PACKAGES:
+                continue  # a subpackage re-exports its modules' names, listed with each module
+            parts += [_entry(module, name) for name in exported] + ([""] if exported else [])
     return "\n".join(parts)
 
 

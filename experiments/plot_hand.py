@@ -8,10 +8,9 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from models.currents import AFFERENT_TYPES
-from population import hand_map
-
-from .plotting import _TYPE_COLOURS
+from ddmm.experiments.plotting import _TYPE_COLOURS
+from ddmm.models.currents import AFFERENT_TYPES, type_label
+from ddmm.population.anatomy import hand_map
 
 __all__ = ["plot_hand", "hand_counts"]
 
@@ -68,7 +67,7 @@ def plot_hand(population, counts=None, ax=None) -> Figure:
 
     Examples
     --------
-    >>> from population import sample_population
+    >>> from ddmm.population import sample_population
     >>> fig = plot_hand(sample_population("hand", rng=0))
     >>> fig.axes[0].get_xlabel()
     'x (mm, radial +)'
@@ -89,7 +88,7 @@ def plot_hand(population, counts=None, ax=None) -> Figure:
         sel = (types == kind) & active
         if np.any(sel):
             ax.scatter(x[sel], y[sel], s=1.5 if counts is None else size[sel], color=_TYPE_COLOURS[kind],
-                       alpha=0.6, lw=0, label=f"{kind} ({int(sel.sum())})")
+                       alpha=0.6, lw=0, label=f"{type_label(kind)} ({int(sel.sum())})")
     ax.set_xlim(*_limits(x, y, region)[0])
     ax.set_ylim(*_limits(x, y, region)[1])
     ax.set_aspect("equal")

@@ -5,10 +5,9 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from models.currents import AFFERENT_TYPES
-from population.physiology import FREQUENCIES_HZ
-
-from .plotting import _TYPE_COLOURS, plot_dsi_histograms
+from ddmm.experiments.plotting import _TYPE_COLOURS, plot_dsi_histograms
+from ddmm.models.currents import AFFERENT_TYPES, type_label
+from ddmm.population.analysis.physiology import FREQUENCIES_HZ
 
 __all__ = ["plot_rest", "plot_on_off", "plot_force_coding", "plot_frequency_tuning", "plot_timing",
            "physiology_figures"]
@@ -59,7 +58,7 @@ def plot_force_coding(data: dict) -> Figure:
     if "rai_loading_counts" in data:
         b.semilogx([2, 8, 32], data["rai_loading_counts"], "o-", color=_TYPE_COLOURS["RAI"])
     b.set_xlabel("force rate (N/s)")
-    b.set_ylabel("RA-I spikes during loading")
+    b.set_ylabel("FA-I spikes during loading")
     return fig
 
 
@@ -70,7 +69,7 @@ def plot_frequency_tuning(data: dict) -> Figure:
     for kind, curve in data.items():
         curve = np.asarray(curve, dtype=float)
         finite = np.isfinite(curve)
-        ax.loglog(np.asarray(FREQUENCIES_HZ)[finite], curve[finite], "o-", color=_TYPE_COLOURS[kind], label=kind)
+        ax.loglog(np.asarray(FREQUENCIES_HZ)[finite], curve[finite], "o-", color=_TYPE_COLOURS[kind], label=type_label(kind))
     ax.axvspan(8, 64, color=_TYPE_COLOURS["RAI"], alpha=0.1)
     ax.axvspan(150, 400, color=_TYPE_COLOURS["RAII"], alpha=0.1)
     ax.set_xlabel("frequency (Hz), 1 N preload")

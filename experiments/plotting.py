@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from models.currents import AFFERENT_TYPES, PAPER_TYPES
+from ddmm.models.currents import AFFERENT_TYPES, PAPER_TYPES, type_label
 
 __all__ = ["plot_response", "plot_sf_vs_theta", "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces",
            "plot_dsi_histograms", "plot_preferred_rose", "plot_neurometric", "plot_pareto"]
@@ -95,7 +95,7 @@ def plot_sf_vs_theta(sf: dict, *, title: str = "SF against tuning angle (Fig. 8)
         for kind in PAPER_TYPES:
             angles = np.array([float(a) for a in sf[profile][kind]])
             values = np.array(list(sf[profile][kind].values()), dtype=float)
-            ax.plot(angles, values, "o-", ms=3, color=_TYPE_COLOURS[kind], label=kind)
+            ax.plot(angles, values, "o-", ms=3, color=_TYPE_COLOURS[kind], label=type_label(kind))
         ax.axvline(90.0, color="grey", ls=":", lw=1)
         ax.set_title(profile)
         ax.set_xlabel("theta_T (deg)")
@@ -143,15 +143,23 @@ def plot_raster(ds, *, condition=0, trial=0, max_afferents: int = 2000) -> Figur
     return fig
 
 
+def _label(group) -> str:
+    """A PSTH group's display label: the type's (FA-I, ...) when the group is a type code."""
+    try:
+        return type_label(str(group))
+    except ValueError:
+        return str(group)
+
+
 def plot_psth(rates) -> Figure:
-    """PSTH per afferent type: ``rates`` is `population.psth` output (condition, type, bin)."""
+    """PSTH per afferent type: ``rates`` is `ddmm.population.psth` output (condition, type, bin)."""
     groups = list(rates[rates.dims[1]].values)
     fig = Figure(figsize=(8.0, 2.2 * len(groups)), layout="constrained")
     axes = fig.subplots(len(groups), 1, sharex=True, squeeze=False)[:, 0]
     for ax, group in zip(axes, groups):
         for c, name in enumerate(rates.condition.values):
             ax.plot(rates.bin.values, rates.isel(condition=c).sel({rates.dims[1]: group}).values, lw=1.0, label=str(name))
-        ax.set_ylabel(f"{group}\n(pulses/s)")
+        ax.set_ylabel(f"{_label(group)}\n(pulses/s)")
     axes[0].legend(fontsize=7)
     axes[-1].set_xlabel("time (s)")
     return fig
@@ -166,7 +174,7 @@ def plot_polar_counts(ds, *, condition=0) -> Figure:
         ax = fig.add_subplot(1, len(kinds), i + 1, projection="polar")
         sel = ds.afferent_type.values == kind
         ax.scatter(np.deg2rad(ds.theta_t.values[sel]), counts[sel], s=4, color=_TYPE_COLOURS[kind])
-        ax.set_title(kind)
+        ax.set_title(type_label(kind))
     fig.suptitle(f"spike count against theta_T: {ds.condition.values[condition]}")
     return fig
 
@@ -199,7 +207,7 @@ def plot_dsi_histograms(tuning, reference: dict | None = None) -> Figure:
             mean, sd = reference[kind]
             ax.axvspan(max(0, mean - sd), mean + sd, color="grey", alpha=0.2, label=f"human {mean} ± {sd}")
             ax.axvline(mean, color="grey", ls="--")
-        ax.set_title(f"{kind} (n = {values.size})")
+        ax.set_title(f"{type_label(kind)} (n = {values.size})")
         ax.set_xlabel("DSI (eq. 7)")
         ax.legend(fontsize=7)
     axes[0].set_ylabel("afferents")
@@ -216,7 +224,7 @@ def plot_preferred_rose(tuning, bins: int = 16) -> Figure:
         counts, _ = np.histogram(np.deg2rad(tuning.preferred_deg.values[sel]), edges)
         ax.bar(edges[:-1], counts, width=edges[1] - edges[0], align="edge", color=_TYPE_COLOURS[kind], alpha=0.7)
         ax.set_xticks(np.deg2rad([0, 90, 180, 270]), ["radial", "distal", "ulnar", "proximal"])
-        ax.set_title(f"{kind}: preferred directions of {int(sel.sum())} tuned\n(vector sum; axial ones omitted)",
+        ax.set_title(f"{type_label(kind)}: preferred directions of {int(sel.sum())} tuned\n(vector sum; axial ones omitted)",
                      fontsize=9, pad=14)
     return fig
 

@@ -1,6 +1,6 @@
 """Reproductions of the paper's Table II, Table III and Fig. 8 (and Figs 6-7).
 
-Every afferent of a reproduction is simulated in one `models.integrate`
+Every afferent of a reproduction is simulated in one `ddmm.models.integrate`
 call, so the engines are compared on exactly the paper's scenes.
 """
 
@@ -10,13 +10,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.attenuation import UNTUNED
-from models.currents import PAPER_TYPES, CurrentParams
-from models.engines import integrate, substeps_for
-from models.metrics import direction_index, spiking_frequency
-from models.pipeline import compute_currents
-from population.scenes import Scene, birznieks, press_push_lift
-
+from ddmm.models.attenuation import UNTUNED
+from ddmm.models.currents import PAPER_TYPES, CurrentParams
+from ddmm.models.engines import integrate, substeps_for
+from ddmm.models.metrics import direction_index, spiking_frequency
+from ddmm.models.pipeline import compute_currents
+from ddmm.population.stimuli.scenes import Scene, birznieks, press_push_lift
 
 __all__ = [
     "PROFILES",
@@ -155,7 +154,7 @@ def response_data(scene: Scene, profile: str, angles, config: ReproConfig = Repr
     angles : sequence of (label, theta_T in deg)
         Conditions, e.g. ``[("aligned", 90.0), ("misaligned", 180.0)]``.
     """
-    from models.attenuation import attenuation_factor
+    from ddmm.models.attenuation import attenuation_factor
 
     thetas = [a for _, a in angles]
     _, result = scene_sf(scene, thetas, config, profiles=(profile,))

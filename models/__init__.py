@@ -1,18 +1,32 @@
 """Single-afferent physics of the DDMM: NAP geometry, attenuation, currents, neurons, engines.
 
-Names are imported on first use (PEP 562): ``import models`` loads nothing
-heavy until a name is touched.
+Modules, in the order a force becomes spikes:
+
+- `nap`: neural attenuation profiles (Table I) and their boundary radius;
+- `attenuation`: the attenuation factor AF of the shear direction (eqs 9-17);
+- `currents`: type-specific filtering of the attenuated force into currents;
+- `neuron`: Izhikevich parameters per type (eqs 4-6);
+- `engines`: the registered engines that integrate the neurons (Brian2, direct);
+- `fused`: the whole pipeline for a block of afferents, as the engines consume it;
+- `pipeline`: the single-afferent convenience (`simulate_afferents`);
+- `metrics`, `rng`, `reference_solver`: spike-train metrics, counter-based
+  random numbers, and a fine-step RK4 reference for accuracy checks.
+
+Names are imported on first use (PEP 562): ``import ddmm.models`` loads
+nothing heavy until a name is touched.
 """
 
 from ._lazy import lazy_exports
 
 _WHERE = {
     "attenuation": ("F_TH", "UNTUNED", "attenuated_force", "attenuation_factor", "shear_magnitude"),
-    "currents": ("AFFERENT_TYPES", "CurrentParams", "afferent_current", "filter_force"),
-    "engines": ("ENGINES", "METHODS", "NeuronState", "SpikeResult", "integrate", "substeps_for"),
+    "currents": ("AFFERENT_TYPES", "CurrentParams", "afferent_current", "filter_force", "normalize_type",
+                 "type_label"),
+    "engines": ("ENGINES", "METHODS", "Engine", "NeuronState", "SpikeResult", "get_engine", "integrate",
+                "substeps_for"),
     "metrics": ("CONTACT_THRESHOLD", "direction_index", "spiking_frequency"),
     "nap": ("PROFILES", "boundary_radius", "k_from_selectivity", "selectivity_from_k"),
     "neuron": ("NEURON_PARAMS", "NeuronParams", "resting_state"),
-    "pipeline": ("compute_currents", "simulate"),
+    "pipeline": ("compute_currents", "simulate_afferents"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

@@ -1,6 +1,6 @@
-"""Numba kernels and numpy transducers of the current stage (`models.currents`).
+"""Numba kernels and numpy transducers of the current stage (`ddmm.models.currents`).
 
-Kept apart so that `models.currents` stays the readable definition of the
+Kept apart so that `ddmm.models.currents` stays the readable definition of the
 stages; these are the hot loops every stage runs through, offline and
 streaming alike.
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .rng import normal_row
+from ddmm.models.rng import normal_row
 
 __all__ = ["filter_sections", "stage_tail", "receptor_noise_keyed", "stage_kernel", "smooth_kernel", "transduce_inplace"]
 
@@ -46,7 +46,7 @@ def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, t
     with its branches outside, so the loops vectorise (one loop with all the
     branches inside ran 10x slower).  With `filter_sections`, the one
     implementation that `stage_kernel` and the fused streaming kernel
-    (`models.fused`) share, so both give the same bits.
+    (`ddmm.models.fused`) share, so both give the same bits.
     """
     fs2 = fs * fs
     # Views from 0: loops over range(lo, hi) vectorise worse.
@@ -104,7 +104,7 @@ def _noisy(d, xi, cv_scale, signed):
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def receptor_noise_keyed(x, lo, hi, key, afferent_id, sample, cv_scale, signed, words, xi):
-    """`stage_tail`'s receptor noise with the draws made here (`models.rng.normal_row`), in place on ``x``.
+    """`stage_tail`'s receptor noise with the draws made here (`ddmm.models.rng.normal_row`), in place on ``x``.
 
     A group with no driven afferent (every d = 0) keeps d = 0 whatever its
     draws, so it draws nothing: the same bits as drawing, at no cost.

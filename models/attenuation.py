@@ -1,9 +1,9 @@
 """Attenuation factor AF(t) and attenuated force F_A(t) (paper eqs 16-18).
 
 ``AF = r(phi) / r(0)``: the NAP boundary radius along the shear direction,
-normalised so that AF = 1 when theta_R = theta_T (DDMM-NOTES §1.3).  When the
+normalised so that AF = 1 when theta_R = theta_T (docs/model.md §1.3).  When the
 shear magnitude F_S is at or below F_TH the paper gives two readings of "no
-shear" (DDMM-NOTES §1.5), selected by ``no_shear``:
+shear" (docs/model.md §1.5), selected by ``no_shear``:
 
 * ``"pass"`` (default, eq. 17): AF = 1, normal loading passes unattenuated.
 * ``"block"`` (the Discussion's reading): AF = 0, nothing passes until shear
@@ -30,8 +30,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from ._validation import as_finite_array, check_choice, check_positive
-from .nap import get_profile, radius_scalar, tip_radius, validate_k
+from ddmm.models._validation import as_finite_array, check_choice, check_positive
+from ddmm.models.nap import get_profile, radius_scalar, tip_radius, validate_k
 
 __all__ = [
     "F_TH",
@@ -49,7 +49,7 @@ __all__ = [
 
 #: Shear threshold F_TH in newtons below which no direction is defined (eq. 17).
 F_TH = 0.1
-#: The readings of "no shear": the paper's two (DDMM-NOTES §1.5; eq. 17, "pass", is
+#: The readings of "no shear": the paper's two (docs/model.md §1.5; eq. 17, "pass", is
 #: the default of `models`) and our continuous one ("smooth", the populations' default).
 NO_SHEAR_READINGS = ("pass", "block", "smooth")
 #: Profile name of an untuned afferent, i.e. the CMM (AF = 1).

@@ -6,7 +6,7 @@ The paper's stage (the default of `CurrentParams`):
 * RAI its rate of change:       ``I = g_rai * |dF_A/dt|``       (eq. 2)
 * RAII its acceleration:        ``I = g_raii * |d^2F_A/dt^2|``  (eq. 3)
 
-with one causal 20 Hz low-pass before the derivatives (DDMM-NOTES §1.6).
+with one causal 20 Hz low-pass before the derivatives (docs/model.md §1.6).
 
 Every departure from it is a named field of `CurrentParams`, off by default,
 which the physiological presets switch on (docs/model.md, "What changed in the model"):
@@ -61,15 +61,15 @@ from functools import lru_cache
 
 import numpy as np
 
-from ._cache import cache_root
-from ._stage_kernels import smooth_kernel, stage_kernel, transduce_inplace
-from ._validation import as_finite_array, check_choice, check_positive
+from ddmm.models._cache import cache_root
+from ddmm.models._stage_kernels import smooth_kernel, stage_kernel, transduce_inplace
+from ddmm.models._validation import as_finite_array, check_positive
 
 __all__ = [
     "PAPER_TYPES",
     "AFFERENT_TYPES",
     "CurrentParams",
-    "Stage",
+    "CurrentStage",
     "FilterState",
     "lowpass_sos",
     "initial_filter_state",
@@ -77,6 +77,10 @@ __all__ = [
     "afferent_current",
     "current_core",
     "check_fs",
+    "TYPE_LABELS",
+    "type_label",
+    "normalize_type",
+    "stage_constants",
 ]
 
 #: The paper's three afferent types (eqs 1-3).
@@ -84,10 +88,49 @@ PAPER_TYPES = ("SAI", "RAI", "RAII")
 #: Every afferent type of the package, in the order used throughout: the paper's
 #: three, then SA-II (Ruffini), which the paper leaves out (its §I).
 AFFERENT_TYPES = PAPER_TYPES + ("SAII",)
+#: Display label of each type code, as the human literature names them (FA = fast
+#: adapting, the paper's RA).  Codes stay the data's names (files, presets, the API).
+TYPE_LABELS = {"SAI": "SA-I", "RAI": "FA-I", "RAII": "FA-II", "SAII": "SA-II"}
+#: Spellings accepted on input for each code (compared without case, "-", "_" or spaces).
+_SPELLINGS = {"SAI": ("SAI", "SA1"), "RAI": ("RAI", "FAI", "RA1", "FA1"), "RAII": ("RAII", "FAII", "RA2", "FA2"),
+              "SAII": ("SAII", "SA2")}
+_CODE_OF = {spelling: code for code, names in _SPELLINGS.items() for spelling in names}
 #: Derivative order of each type's drive: force, velocity, acceleration, stretch.
 DERIVATIVE_ORDER = {"SAI": 0, "RAI": 1, "RAII": 2, "SAII": 0}
 #: A scene must be sampled at least this many times faster than RA-II's cut-off.
 RAII_FS_FACTOR = 2.5
+
+
+def type_label(afferent_type: str) -> str:
+    """The display label of a type code (``"RAI"`` -> ``"FA-I"``), for figures and text.
+
+    Examples
+    --------
+    >>> [type_label(t) for t in AFFERENT_TYPES]
+    ['SA-I', 'FA-I', 'FA-II', 'SA-II']
+    """
+    return TYPE_LABELS[normalize_type(afferent_type)]
+
+
+def normalize_type(afferent_type, name: str = "afferent_type") -> str:
+    """The type code of any accepted spelling: ``"FA-I"``, ``"RA-I"``, ``"fa1"`` -> ``"RAI"``.
+
+    Raises
+    ------
+    ValueError
+        Naming ``name``, the value and the allowed spellings.
+
+    Examples
+    --------
+    >>> normalize_type("FA-II"), normalize_type("SA-I"), normalize_type("RAI")
+    ('RAII', 'SAI', 'RAI')
+    """
+    if isinstance(afferent_type, str):
+        key = afferent_type.upper().replace("-", "").replace("_", "").replace(" ", "")
+        if key in _CODE_OF:
+            return _CODE_OF[key]
+    raise ValueError(f"{name}={afferent_type!r} is not an afferent type; allowed: "
+                     f"{', '.join(AFFERENT_TYPES)} or {', '.join(TYPE_LABELS.values())} (RA-I/RA-II too)")
 
 
 def _optional_positive(obj, names, unit):
@@ -115,10 +158,10 @@ class CurrentParams:
         RAII gain, (mV/ms) per (N/s^2) (eq. 3).
     cutoff_hz : float
         Cut-off in Hz of the causal Butterworth low-pass applied to F_A before
-        differentiation (DDMM-NOTES §1.6: 20 Hz restores Table III's
+        differentiation (docs/model.md §1.6: 20 Hz restores Table III's
         aligned > misaligned ordering for RAII).
     filter_order : int
-        Order of that Butterworth filter (2 in the notes' trial).
+        Order of that Butterworth filter (2 in the trial of docs/model.md §1.6).
     i_sat : float or None
         Scale of the log compression in mV/ms, for every paper type:
         ``I = i_sat * log1p(g * x / i_sat)``.  None: linear, as eqs 1-3.
@@ -224,7 +267,7 @@ class CurrentParams:
 
     def gain(self, afferent_type: str) -> float:
         """The gain of ``afferent_type`` (``"SAI"``, ``"RAI"``, ``"RAII"`` or ``"SAII"``)."""
-        check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
+        afferent_type = normalize_type(afferent_type)
         return self._own("g", afferent_type)
 
     def saturation(self, afferent_type: str) -> float | None:
@@ -234,24 +277,24 @@ class CurrentParams:
         own = self._own("i_sat", afferent_type)
         return self.i_sat if own is None else own
 
-    def stage(self, afferent_type: str) -> "Stage":
+    def stage(self, afferent_type: str) -> "CurrentStage":
         """The resolved stage of one type: filter, derivative order, transducer."""
-        check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
+        afferent_type = normalize_type(afferent_type)
         cutoff = self._own("cutoff", afferent_type, "_hz")
         if afferent_type in ("RAI", "RAII"):
             cutoff = cutoff or self.cutoff_hz  # the paper's shared low-pass before the derivatives
         order = self.order_raii if afferent_type == "RAII" and self.order_raii is not None else self.filter_order
         tau_adapt = self._own("tau_adapt", afferent_type, "_s", self.tau_adapt_sai_s)
-        return Stage(afferent_type, DERIVATIVE_ORDER[afferent_type], cutoff, order,
-                     self._own("adapt", afferent_type, default=0.0), tau_adapt, self.gain(afferent_type),
-                     self.saturation(afferent_type), self._own("i_max", afferent_type),
-                     self._own("bias", afferent_type, default=0.0), self._own("tau", afferent_type, "_s"),
-                     self._own("threshold", afferent_type, default=0.0),
-                     self._own("highpass", afferent_type, "_hz"))
+        return CurrentStage(afferent_type, DERIVATIVE_ORDER[afferent_type], cutoff, order,
+                            self._own("adapt", afferent_type, default=0.0), tau_adapt, self.gain(afferent_type),
+                            self.saturation(afferent_type), self._own("i_max", afferent_type),
+                            self._own("bias", afferent_type, default=0.0), self._own("tau", afferent_type, "_s"),
+                            self._own("threshold", afferent_type, default=0.0),
+                            self._own("highpass", afferent_type, "_hz"))
 
 
 @dataclass(frozen=True)
-class Stage:
+class CurrentStage:
     """One type's resolved current stage (see `CurrentParams.stage`).
 
     Attributes
@@ -404,7 +447,7 @@ def _filter_cache():
 _PASS_THROUGH = np.array([[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]])  # an identity section: no filter
 
 
-def _stage_sos(stage: Stage, fs: float) -> np.ndarray:
+def _stage_sos(stage: CurrentStage, fs: float) -> np.ndarray:
     if stage.cutoff_hz is None:
         return _PASS_THROUGH
     if not stage.cutoff_hz < fs / 2.0:
@@ -458,7 +501,7 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
         State after the last sample.
     """
     f_a = as_finite_array(f_a, "f_a", ndim=2)
-    shared = Stage("RAI", 0, params.cutoff_hz, params.filter_order, 0.0, 1.0, 1.0, None, None, 0.0)
+    shared = CurrentStage("RAI", 0, params.cutoff_hz, params.filter_order, 0.0, 1.0, 1.0, None, None, 0.0)
     if state is None:
         state = initial_filter_state(f_a[0], fs, params)
     m = f_a.shape[1]
@@ -484,7 +527,7 @@ def afferent_current(
     ----------
     f_a : array_like, shape (n_samples, n_afferents)
         Attenuated force F_A in newtons at sample rate ``fs`` (for SA-II, the
-        signed stretch drive in newtons, see `models.attenuation.stretch_drive`).
+        signed stretch drive in newtons, see `ddmm.models.attenuation.stretch_drive`).
     fs : float
         Sample rate in Hz.
     afferent_type : {"SAI", "RAI", "RAII", "SAII"}
@@ -512,7 +555,7 @@ def afferent_current(
     >>> round(float(i[-1, 0]), 2)                          # settles at 1 N/s
     1.0
     """
-    check_choice(afferent_type, "afferent_type", AFFERENT_TYPES)
+    afferent_type = normalize_type(afferent_type)
     fs = check_positive(fs, "fs", "Hz")
     f_a = as_finite_array(f_a, "f_a", ndim=2)
     check_fs(fs, params, (afferent_type,))
@@ -526,12 +569,12 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     ``noise_cv`` (sqrt(ms), per afferent) add the receptor noise of the
     module docstring; without them the current is noise-free.  Every stage
     after the paper's unfiltered SAI runs in one numba pass
-    (`models._stage_kernels.stage_kernel`) and numpy's vectorised
-    transducers; `models.fused` runs the same arithmetic for the streaming
+    (`ddmm.models._stage_kernels.stage_kernel`) and numpy's vectorised
+    transducers; `ddmm.models.fused` runs the same arithmetic for the streaming
     encoder.
     """
     fs = float(fs)
-    st, sos, alpha_adapt, alpha_smooth = _stage_constants(params, afferent_type, fs)
+    st, sos, alpha_adapt, alpha_smooth = stage_constants(params, afferent_type, fs)
     gain = st.gain if scale is None else st.gain * np.asarray(scale, dtype=float)
     noisy = normals is not None and noise_cv is not None and bool(np.any(np.asarray(noise_cv) > 0))
     if st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None:
@@ -560,7 +603,7 @@ _NO_NORMALS = np.zeros((1, 0))
 
 
 @lru_cache(maxsize=256)
-def _stage_constants(params: CurrentParams, afferent_type: str, fs: float):
+def stage_constants(params: CurrentParams, afferent_type: str, fs: float):
     """(stage, filter sections, adaptation and smoothing coefficients), cached: per call they would
     cost a short chunk more than its arithmetic."""
     stage = params.stage(afferent_type)

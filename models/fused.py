@@ -1,7 +1,7 @@
 """The pipeline from force to spikes fused into two numba passes over samples (the streaming hot path).
 
-The per-stage functions (`models.attenuation`, `models.currents`,
-`models.engines`) stay the definition of the model.  `FusedPlan` runs the
+The per-stage functions (`ddmm.models.attenuation`, `ddmm.models.currents`,
+`ddmm.models.engines`) stay the definition of the model.  `FusedPipeline` runs the
 same arithmetic, sample by sample, with every per-call constant packed once
 into tables:
 
@@ -17,7 +17,7 @@ into tables:
    additive noise, then the direct engine's integrator.
 
 For the streaming encoder's large populations, both passes also run on
-afferent ranges in parallel (`_front_parts`, `models.direct.integrate_parts`):
+afferent ranges in parallel (`_front_parts`, `ddmm.models.engines.direct.integrate_parts`):
 afferents are independent, so the bits are the same.
 
 Because the scalar helpers are the very functions the per-stage kernels
@@ -33,16 +33,16 @@ import math
 import numba as nb
 import numpy as np
 
-from ._stage_kernels import filter_sections, receptor_noise_keyed, stage_tail, transduce_inplace
-from .attenuation import UNTUNED, profile_value
-from .currents import _stage_constants
-from .direct import _BLOCK, _METHOD_CODES, _integrate_range, integrate_parts, part_bounds, spike_checks
-from .engines import NeuronState, check_integration, check_stability, run_checked, substeps_for
-from .nap import get_profile, tip_radius
-from .neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
-from .rng import normal_row
+from ddmm.models._stage_kernels import filter_sections, receptor_noise_keyed, stage_tail, transduce_inplace
+from ddmm.models.attenuation import UNTUNED, profile_value
+from ddmm.models.currents import stage_constants
+from ddmm.models.engines import NeuronState, check_integration, check_stability, get_engine, run_checked, substeps_for
+from ddmm.models.engines.direct import BLOCK, METHOD_CODES, integrate_parts, integrate_range, part_bounds, spike_checks
+from ddmm.models.nap import get_profile, tip_radius
+from ddmm.models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
+from ddmm.models.rng import normal_row
 
-__all__ = ["FusedPlan", "mix_forces", "mixing_matrix"]
+__all__ = ["FusedPipeline", "mix_forces", "mixing_matrix"]
 
 # Rows of the per-afferent float table.
 _COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA = range(12)
@@ -53,7 +53,7 @@ _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = ran
 _OFFSET, _Y1, _Y2, _SLOW, _SMOOTH = range(5)
 
 _RANGE = 512  # afferents per range of the front pass: its state and scratch fit in cache
-_SLICE = 1 << 17  # current elements per time slice of `FusedPlan.currents`
+_SLICE = 1 << 17  # current elements per time slice of `FusedPipeline.currents`
 _NO_NORMALS = np.zeros((0, 1)).T  # same layout as a transposed noise block
 _NO_FORCES, _NO_SITES, _NO_WEIGHTS = np.zeros((0, 3)), np.zeros((0, 0, 3)), np.zeros((0, 0))
 
@@ -100,7 +100,7 @@ def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_r
 
 
 def mixing_matrix(indptr, indices, coeff, n_sites: int) -> np.ndarray:
-    """The sparse local-force coefficients (`population.spatial.local_mixing`) as a dense (n_sites, n_afferents)."""
+    """The sparse local-force coefficients (`ddmm.population.anatomy.receptive_fields.local_mixing`) as a dense (n_sites, n_afferents)."""
     m = indptr.size - 1
     out = np.zeros((n_sites, m))
     rows = np.repeat(np.arange(m), np.diff(indptr))
@@ -297,13 +297,13 @@ def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f
     lowest = _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i, sigma_idx)
     if not integrate:
         return np.empty(0, np.int64), np.empty(0, np.int64), lowest, True, False
-    idx, stp = _integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, 0,
+    idx, stp = integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, 0,
                                 v.size)
     finite, capped, _ = spike_checks(idx, stp, v, u)
     return idx, stp, lowest, finite, capped
 
 
-class FusedPlan:
+class FusedPipeline:
     """Tables of the fused pipeline for one population, ordered so that each type's afferents are contiguous.
 
     Parameters
@@ -335,8 +335,8 @@ class FusedPlan:
 
     Examples
     --------
-    >>> from models.currents import CurrentParams
-    >>> plan = FusedPlan(["SAI"], ["none"], [0.0], [1.0], [1.0], [0.0], [0.0], CurrentParams(), 1000.0, "pass", 0.1)
+    >>> from ddmm.models.currents import CurrentParams
+    >>> plan = FusedPipeline(["SAI"], ["none"], [0.0], [1.0], [1.0], [0.0], [0.0], CurrentParams(), 1000.0, "pass", 0.1)
     >>> plan.currents(np.array([[0.0, 0.0, 2.0]]), plan.new_state(), False).shape
     (1, 1)
     """
@@ -354,7 +354,7 @@ class FusedPlan:
         change = (afferent_type[1:] != afferent_type[:-1]) | ((nap[1:] == UNTUNED) != (nap[:-1] == UNTUNED))
         bounds = np.flatnonzero(np.r_[True, change, True])  # runs of one type, tuned or not
         spans = list(zip(bounds[:-1], bounds[1:]))
-        consts = [_stage_constants(params, str(afferent_type[a]), self.fs) for a, _ in spans]
+        consts = [stage_constants(params, str(afferent_type[a]), self.fs) for a, _ in spans]
         noise_cv, noise_sigma = np.asarray(noise_cv, dtype=float), np.asarray(noise_sigma, dtype=float)
         self.aff_f = self._afferent_tables(afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma,
                                                        spans, consts)
@@ -416,7 +416,7 @@ class FusedPlan:
             v, u = (np.array(x, dtype=float) for x in resting_state(args[5]))
         else:
             v, u = neuron.v.copy(), neuron.u.copy()
-        if engine != "direct":  # the plan's currents need no second check at the seam
+        if not get_engine(engine).fused:  # the pipeline's currents need no second check at the seam
             params = dict(zip("abcd", args[4:8]))
             res = run_checked(self.currents(forces, state, started, sample0, key), args[0], dt, params, v, u,
                               engine, method)
@@ -430,13 +430,13 @@ class FusedPlan:
         return afferent, step, NeuronState(v, u)
 
     def _neuron_args(self, dt, method):
-        """The direct engine's arguments for (dt, method), cached (as `models.direct.run_direct` computes them)."""
+        """The direct engine's arguments for (dt, method), cached (as `ddmm.models.engines.direct.run_direct` computes them)."""
         key = (float(dt), method)
         if key not in self._neuron_cache:
             p = neuron_arrays(self.afferent_type)
             h, half = 1.0 * dt / 0.001, (1.0 * (0.5 * dt)) / 0.001
-            self._neuron_cache[key] = (substeps_for(self.fs, dt), _METHOD_CODES[method], h, half, p["a"], p["b"],
-                                       p["c"], p["d"], V_PEAK, V_FLOOR, _BLOCK)
+            self._neuron_cache[key] = (substeps_for(self.fs, dt), METHOD_CODES[method], h, half, p["a"], p["b"],
+                                       p["c"], p["d"], V_PEAK, V_FLOOR, BLOCK)
         return self._neuron_cache[key]
 
     def new_state(self) -> np.ndarray:
@@ -467,8 +467,8 @@ class FusedPlan:
         run in slices of time of `_SLICE` elements, with the same result.
         ``state`` is updated in place; ``started`` is False on the first
         chunk, whose first sample is sample ``sample0`` of the scene.  With
-        a stream ``key`` (`models.rng.stream_key`), the noise of sample n of
-        afferent a is ``models.rng.normal(key, a, n)``; None: noise-free.
+        a stream ``key`` (`ddmm.models.rng.stream_key`), the noise of sample n of
+        afferent a is ``ddmm.models.rng.normal(key, a, n)``; None: noise-free.
         """
         n, step = forces.shape[0], max(1, _SLICE // max(1, self.n_afferents))
         if n <= step:
@@ -489,7 +489,7 @@ class FusedPlan:
         """Currents, then the direct engine: (current, afferent, step, smallest current, finite, capped).
 
         Arguments as `currents`; ``neuron`` is (substeps, method code, h,
-        half, a, b, c, d, v_peak, v_floor, block) as `models.direct` takes
+        half, a, b, c, d, v_peak, v_floor, block) as `ddmm.models.engines.direct` takes
         them; ``v``, ``u`` and ``state`` are updated in place.  With
         ``parts`` > 1 the integration runs on that many column ranges in
         parallel (the spikes are the same, ordered range by range).

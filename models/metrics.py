@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_finite_array, check_positive
+from ddmm.models._validation import as_finite_array, check_positive
 
 __all__ = ["CONTACT_THRESHOLD", "active_mask", "spiking_frequency", "direction_index"]
 
 #: Normal force in newtons above which the finger is "in contact"; SF is
-#: averaged over that active period (paper §IV.C, DDMM-NOTES §1.8).
+#: averaged over that active period (paper §IV.C, docs/model.md §1.8).
 CONTACT_THRESHOLD = 0.05
 
 

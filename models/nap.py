@@ -4,7 +4,7 @@ A NAP is the closed curve of eq. 9 in the shear plane,
 
     p1 * (|k X| + |p2 Y - p3| - p4) - p5 Y = 0,
 
-rotated so that its tip points at the tuning angle theta_T (DDMM-NOTES §1.1:
+rotated so that its tip points at the tuning angle theta_T (docs/model.md §1.1:
 the paper's eqs 10-11 put the tip on the rotated Y axis, its text puts the
 tip at theta_T).  Along a ray at angle phi from the tip axis, X = r sin(phi)
 and Y = r cos(phi), so eq. 9 is piecewise *linear* in the radius r and each
@@ -17,7 +17,6 @@ Angles are radians here; the public population API speaks degrees.
 from __future__ import annotations
 
 from dataclasses import dataclass
-
 from functools import lru_cache
 
 import numba as nb
@@ -51,7 +50,7 @@ class NAPProfile:
     b : float
         Aspect constant of eq. 12, ``k = b / tan(theta_A / 2)``.  b = 1 for
         the bipolar and selective profiles and b = 3 for the broad one, so the
-        drawn tip half-angle equals theta_A / 2 (DDMM-NOTES §1.4).
+        drawn tip half-angle equals theta_A / 2 (docs/model.md §1.4).
     k_min : float
         Smallest admissible sharpness k (Table I footnote: broad needs
         k >= 1.8); 0 means any k > 0.
@@ -67,7 +66,7 @@ class NAPProfile:
     k_min: float = 0.0
 
 
-#: Table I of the paper, with the eq. 12 aspect constants of DDMM-NOTES §1.4.
+#: Table I of the paper, with the eq. 12 aspect constants of docs/model.md §1.4.
 PROFILES: dict[str, NAPProfile] = {
     "bipolar": NAPProfile("bipolar", 1.0, 1.0, 0.0, 1.0, 0.0, b=1.0),
     "selective": NAPProfile("selective", 1.0, 2.0, 0.2, 0.8, 1.0, b=1.0),
@@ -183,7 +182,7 @@ def selectivity_from_k(k, profile: str | NAPProfile):
 def boundary_radius(sin_phi, cos_phi, profile: str | NAPProfile, k) -> np.ndarray:
     """Radius of the NAP boundary along rays at angle phi from the tip axis.
 
-    Closed form of eq. 9 (DDMM-NOTES §1.2).  With ``s = |sin phi|`` and
+    Closed form of eq. 9 (docs/model.md §1.2).  With ``s = |sin phi|`` and
     ``c = cos phi`` the two linear pieces are
 
     * ``p2 c r >= p3``:  ``r = p1 (p3 + p4) / (p1 k s + p1 p2 c - p5 c)``
@@ -267,7 +266,7 @@ def __getattr__(name):
 def tip_radius(profile: str | NAPProfile) -> float:
     """Boundary radius at the tip (phi = 0): 1 for bipolar and selective, 13/15 for broad.
 
-    AF is normalised by this value so that AF = 1 at alignment (DDMM-NOTES §1.3).
+    AF is normalised by this value so that AF = 1 at alignment (docs/model.md §1.3).
 
     Examples
     --------

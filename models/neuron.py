@@ -6,7 +6,7 @@
 
 A = 0.02, C = -65, D = 8 for every type.  B = 0.2 for SAI (regular spiking)
 and B = 0.25 for RAI and RAII (low-threshold spiking; the paper's "RAI and
-RAI" is a typo for RAI and RAII, DDMM-NOTES §1.7).  SA-II, which the paper
+RAI" is a typo for RAI and RAII, docs/model.md §1.7).  SA-II, which the paper
 leaves out, is regular spiking like SA-I (B = 0.2): Ruffini afferents fire
 regularly and adapt slowly.
 
@@ -23,8 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import check_choice
-from .currents import AFFERENT_TYPES
+from ddmm.models.currents import AFFERENT_TYPES, normalize_type
 
 __all__ = [
     "V_PEAK",
@@ -131,8 +130,9 @@ def neuron_arrays(afferent_type, params: dict[str, NeuronParams] | None = None):
     """
     table = dict(NEURON_PARAMS, **(params or {}))
     types = np.atleast_1d(np.asarray(afferent_type, dtype=object))
-    for t in np.unique(types):
-        check_choice(t, "afferent_type", AFFERENT_TYPES)
+    codes = {t: normalize_type(t) for t in set(types.tolist())}
+    if any(t != c for t, c in codes.items()):
+        types = np.array([codes[t] for t in types.tolist()], dtype=object)
     out = {}
     for field in ("a", "b", "c", "d"):
         lookup = {t: getattr(table[t], field) for t in AFFERENT_TYPES}

@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import check_forces, check_positive
-from .attenuation import F_TH, attenuated_force, attenuation_factor, profile_factor, stretch_drive
-from .currents import AFFERENT_TYPES, CurrentParams, afferent_current
-from .engines import SpikeResult, integrate
+from ddmm.models._validation import check_forces, check_positive
+from ddmm.models.attenuation import F_TH, attenuated_force, attenuation_factor, profile_factor, stretch_drive
+from ddmm.models.currents import AFFERENT_TYPES, CurrentParams, afferent_current
+from ddmm.models.engines import SpikeResult, integrate
 
-__all__ = ["compute_currents", "simulate"]
+__all__ = ["compute_currents", "simulate_afferents"]
 
 
 def compute_currents(
@@ -91,7 +91,7 @@ def compute_currents(
     return current
 
 
-def simulate(
+def simulate_afferents(
     fx,
     fy,
     fz,
@@ -129,7 +129,7 @@ def simulate(
     >>> t = np.arange(500) / 1000.0
     >>> fz = np.interp(t, [0, 0.125, 0.375, 0.5], [0, 4, 4, 0])
     >>> fy = fz * np.tan(np.deg2rad(20.0))
-    >>> res = simulate(np.zeros(500), fy, fz, fs=1000.0, afferent_type="SAI",
+    >>> res = simulate_afferents(np.zeros(500), fy, fz, fs=1000.0, afferent_type="SAI",
     ...                profile="selective", theta_t=[90.0, 270.0], engine="direct")
     >>> c = res.counts(2)
     >>> bool(c[0] > c[1])

@@ -35,12 +35,11 @@ import numba as nb
 import numpy as np
 import xarray as xr
 
-from models.attenuation import F_TH
-from models.metrics import CONTACT_THRESHOLD
-from models.neuron import NEURON_PARAMS, V_PEAK
-
-from ._files import atomic_write, writable_parent
-from .spatial import RF_SIGMA_MM, RF_SUPPORT
+from ddmm.models.attenuation import F_TH
+from ddmm.models.metrics import CONTACT_THRESHOLD
+from ddmm.models.neuron import NEURON_PARAMS, V_PEAK
+from ddmm.population.anatomy.receptive_fields import RF_SIGMA_MM, RF_SUPPORT
+from ddmm.population.io._files import atomic_write, writable_parent
 
 __all__ = ["build_dataset", "save_dataset", "load_dataset", "binned_counts", "binned_rates", "psth",
            "describe_dataset"]
@@ -92,7 +91,7 @@ def _afferent_coords(population, index) -> dict:
         "noise_sigma": ("afferent", pop.noise_sigma[index].astype(float), {"units": "mV/sqrt(ms)"}),
         "noise_cv": ("afferent", pop.noise_cv[index].astype(float), {"units": "sqrt(ms)"}),
         "region": ("afferent", pop.region[index].astype(object),
-                   {"units": "1", "long_name": "hand-map region (population.hand_map), empty when unknown"}),
+                   {"units": "1", "long_name": "hand-map region (ddmm.population.anatomy.hand_map), empty when unknown"}),
         "frame_deg": ("afferent", pop.frame_deg[index].astype(float),
                       {"units": "deg", "long_name": "rotation from the local digit frame to the hand frame"}),
     }
@@ -313,7 +312,7 @@ def binned_rates(ds: xr.Dataset, bin_s: float, **kwargs) -> xr.DataArray:
 
     Examples
     --------
-    >>> from population import make_population, birznieks, simulate
+    >>> from ddmm.population import make_population, birznieks, simulate
     >>> ds = simulate(make_population(["SAI"]), birznieks(90.0), engine="direct", quiet=True)
     >>> binned_rates(ds, 0.1).sizes["bin"]
     5

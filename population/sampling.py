@@ -2,7 +2,7 @@
 
 `sample_population` returns a `Population`: one array per afferent property,
 ordered SAI, RAI, RAII, SAII.  With a ``[map]`` each type is placed region by
-region of `population.hand_map` (uniform within a region).  Every afferent carries a stable ``afferent_id``;
+region of `ddmm.population.anatomy.hand_map` (uniform within a region).  Every afferent carries a stable ``afferent_id``;
 per-afferent random streams (the current noise) are derived from it, so
 splitting a population into chunks, or keeping only some types, never
 changes any afferent's result.
@@ -14,12 +14,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from models.attenuation import UNTUNED
-from models.currents import AFFERENT_TYPES, CurrentParams
-from models.nap import PROFILE_NAMES, k_from_selectivity, validate_k
-
-from . import hand_map
-from .spec import NAP_CHOICES, AngleDistribution, PopulationSpec, SharpnessDistribution, TypeSpec, load_spec
+from ddmm.models.attenuation import UNTUNED
+from ddmm.models.currents import AFFERENT_TYPES, CurrentParams, normalize_type
+from ddmm.models.nap import PROFILE_NAMES, k_from_selectivity, validate_k
+from ddmm.population.anatomy import hand_map
+from ddmm.population.spec import (
+    NAP_CHOICES,
+    AngleDistribution,
+    PopulationSpec,
+    SharpnessDistribution,
+    TypeSpec,
+    load_spec,
+)
 
 __all__ = ["Population", "sample_population", "make_population"]
 
@@ -54,7 +60,7 @@ class Population:
     afferent_id : ndarray of int64
         Stable identity; noise streams derive from it.
     region : ndarray of str
-        Hand-map region (`population.hand_map`), ``""`` when unknown.
+        Hand-map region (`ddmm.population.anatomy.hand_map`), ``""`` when unknown.
     frame_deg : ndarray of float
         Counterclockwise rotation (deg) from the afferent's local digit frame
         to the hand frame (0 for D2, the palm and unknown regions).
@@ -274,7 +280,8 @@ def make_population(afferent_type, theta_t=0.0, nap=UNTUNED, k=3.0, *, gain=1.0,
     >>> pop.k.tolist()
     [3.0, 3.0]
     """
-    types = np.atleast_1d(np.asarray(afferent_type, dtype=object))
+    types = np.array([normalize_type(t) for t in np.atleast_1d(np.asarray(afferent_type, dtype=object)).tolist()],
+                     dtype=object)
     n = types.size
     nap = np.broadcast_to(np.asarray(nap, dtype=object), (n,))
     k = np.where(nap == UNTUNED, 0.0, np.broadcast_to(np.asarray(k, float), (n,)))

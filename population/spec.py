@@ -4,12 +4,12 @@ A spec is a TOML file or the matching frozen dataclasses.  Unknown keys,
 negative counts, NAP fractions that do not sum to 1 and unknown distributions
 are rejected with a `ValueError` naming the key.  Two presets ship inside the
 package: ``fingertip`` (TouchSim's index-fingertip pad, region ``D2d`` of the
-hand map) and ``hand`` (the glabrous hand of `population.hand_map`).
+hand map) and ``hand`` (the glabrous hand of `ddmm.population.anatomy.hand_map`).
 
 Frame: +X radial, +Y distal (mm, fingertip frame), so theta = 0 deg is radial,
 90 deg distal, 180 deg ulnar and 270 deg proximal.  With a ``[map]`` the
 positions are in the hand frame and theta_T in each afferent's local digit
-frame (`population.hand_map`).
+frame (`ddmm.population.anatomy.hand_map`).
 
 TOML layout (every table optional unless marked)::
 
@@ -22,7 +22,7 @@ TOML layout (every table optional unless marked)::
     # [map]
     # name = "hand"                # counts from the map's densities (row 16)
     # regions = ["D2d", "D2m"]     # optional subset (default: every region)
-    [current]                      # overrides of models.CurrentParams
+    [current]                      # overrides of ddmm.models.CurrentParams
     g_sai = 5.367
     [types.SAI]                    # one table per type present
     count = 282                    # or density_per_cm2 = 70.0
@@ -49,11 +49,10 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from models.attenuation import UNTUNED
-from models.currents import AFFERENT_TYPES, CurrentParams
-from models.nap import PROFILE_NAMES
-
-from . import hand_map
+from ddmm.models.attenuation import UNTUNED
+from ddmm.models.currents import AFFERENT_TYPES, CurrentParams, normalize_type
+from ddmm.models.nap import PROFILE_NAMES
+from ddmm.population.anatomy import hand_map
 
 __all__ = [
     "NAP_CHOICES",
@@ -216,7 +215,7 @@ class Region:
 
 @dataclass(frozen=True)
 class MapSpec:
-    """Afferents placed by a map of the hand (`population.hand_map`).
+    """Afferents placed by a map of the hand (`ddmm.population.anatomy.hand_map`).
 
     Attributes
     ----------
@@ -434,9 +433,16 @@ def spec_from_dict(data: dict, *, default_name: str = "custom") -> PopulationSpe
     types = data.get("types", {})
     if not isinstance(types, dict) or not types:
         _fail("types", "a spec needs at least one afferent type table, e.g. [types.SAI]")
+    codes = {}
     for kind in types:
-        if kind not in AFFERENT_TYPES:
-            _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)}")
+        try:
+            codes[kind] = normalize_type(kind)
+        except ValueError:
+            _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)} "
+                                   "(or SA-I, FA-I, FA-II, SA-II)")
+    if len(set(codes.values())) != len(codes):
+        _fail("types", f"two tables name one afferent type: {', '.join(codes)}")
+    data = dict(data, types={codes[kind]: table for kind, table in types.items()})
     if "map" in data and "region" in data:
         _fail("region", "a spec with a [map] places afferents by the map; remove [region]")
     return _build(PopulationSpec, data, "", {
@@ -450,7 +456,7 @@ def spec_from_dict(data: dict, *, default_name: str = "custom") -> PopulationSpe
 @functools.lru_cache(maxsize=None)
 def _preset(name: str) -> PopulationSpec:
     """A packaged preset, parsed once per process (`load_spec` hands out deep copies)."""
-    text = resources.files("population").joinpath("presets", f"{name}.toml").read_text()
+    text = resources.files("ddmm.population").joinpath("presets", f"{name}.toml").read_text()
     return spec_from_dict(tomllib.loads(text), default_name=name)
 
 

@@ -5,7 +5,7 @@
   them), in a temporary directory; a block that raises fails the suite.
 * Every ``ddmm ...`` line of a ```bash block parses with the CLI's own parser
   (the commands themselves are run by their own tests).
-* ``docs/cli.md`` and ``docs/api.md`` are what `experiments.docs_reference`
+* ``docs/cli.md`` and ``docs/api.md`` are what `ddmm.experiments.docs_reference`
   generates.
 * Every figure in ``docs/`` exists and names the command that makes it.
 """
@@ -51,7 +51,7 @@ def _ddmm_commands(page: Path) -> list:
 
 @pytest.mark.parametrize("page", [p for p in PAGES if _ddmm_commands(p)], ids=lambda p: p.name)
 def test_ddmm_commands_parse(page):
-    from experiments.cli import build_parser
+    from ddmm.experiments.cli import build_parser
 
     parser = build_parser()
     for argv in _ddmm_commands(page):
@@ -68,11 +68,11 @@ def test_the_docs_have_code():
 
 @pytest.mark.parametrize("name", ["cli.md", "api.md"])
 def test_reference_pages_match_the_code(name):
-    from experiments.docs_reference import api_reference, cli_reference
+    from ddmm.experiments.docs_reference import api_reference, cli_reference
 
     generated = {"cli.md": cli_reference, "api.md": api_reference}[name]()
     assert (DOCS / name).read_text() == generated, (
-        f"docs/{name} is stale: run `python -m experiments.docs_reference`")
+        f"docs/{name} is stale: run `python -m ddmm.experiments.docs_reference`")
 
 
 def test_figures_exist_and_name_their_command():

@@ -6,15 +6,17 @@ import pkgutil
 
 import pytest
 
-PACKAGES = ("models", "population", "experiments")
+PACKAGES = ("ddmm.models", "ddmm.population", "ddmm.experiments")
 
 
 def _modules():
+    yield "ddmm"
     for name in PACKAGES:
         pkg = importlib.import_module(name)
         yield name
         for info in pkgutil.walk_packages(pkg.__path__, prefix=f"{name}."):
-            yield info.name
+            if not info.name.endswith("__main__"):
+                yield info.name
 
 
 @pytest.mark.parametrize("module_name", sorted(_modules()))
@@ -29,13 +31,13 @@ def test_docstring_examples(module_name):
 
 
 def test_packages_import_lazily_and_keep_their_names():
-    """``import population`` loads no xarray, scipy.signal, Brian2, pynwb or neo; ``simulate`` stays the function."""
+    """``import ddmm.population`` loads no xarray, scipy.signal, Brian2, pynwb or neo; ``simulate`` stays the function."""
     import subprocess
     import sys
 
-    code = ("import sys, population; heavy = [m for m in ('xarray', 'scipy.signal', 'brian2', 'dask', 'pynwb', 'neo')"
+    code = ("import sys, ddmm, ddmm.population; heavy = [m for m in ('xarray', 'scipy.signal', 'brian2', 'dask', 'pynwb', 'neo')"
             " if m in sys.modules];"
-            "import population.simulate; from population import simulate, to_neo, to_nwb;"
+            "import ddmm.population.simulation; from ddmm.population import simulate, to_neo, to_nwb;"
             "print(heavy, callable(simulate) and simulate.__name__ == 'simulate',"
             " [m for m in ('pynwb', 'neo') if m in sys.modules])")  # the exporters import theirs when called
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()

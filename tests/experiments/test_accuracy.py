@@ -7,11 +7,11 @@ import warnings
 import numpy as np
 import pytest
 
-from experiments.accuracy import _compare, _run_times, measure, reference_times, workload
-from experiments.cli import main
-from models.engines import SpikeCapWarning
-from population import rotating_shear, simulate
-from population.accuracy import choose_setting, load_table
+from ddmm.experiments.accuracy import _compare, _run_times, measure, reference_times, workload
+from ddmm.experiments.cli import main
+from ddmm.models.engines import SpikeCapWarning
+from ddmm.population import rotating_shear, simulate
+from ddmm.population.runtime.step_choice import choose_setting, load_table
 
 ROW_KEYS = {"dt_ms", "method", "engine", "wall_s_per_afferent_s", "sf_err_mean", "sf_err_max", "spike_time_err_ms",
             "count_mismatch", "prsi_err", "decode_err_delta_deg"}

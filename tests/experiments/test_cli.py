@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from experiments.cli import main
+from ddmm.experiments.cli import main
 
 
 def run(capsys, *argv):
@@ -63,7 +63,7 @@ def test_unwritable_out_is_one_line_error(capsys, tmp_path):
 
 def test_every_help_page_prints(capsys):
     """``ddmm --help`` and each command's ``--help`` exit 0 (a stray % in a help string once broke the top one)."""
-    from experiments.cli import build_parser, main
+    from ddmm.experiments.cli import build_parser, main
 
     commands = build_parser()._subparsers._group_actions[0].choices
     for argv in [["--help"]] + [[c, "--help"] for c in commands]:
@@ -74,7 +74,7 @@ def test_every_help_page_prints(capsys):
 
 
 def test_plot_scaling_and_bench_case_names():
-    from experiments.plotting import plot_scaling
+    from ddmm.experiments.plotting import plot_scaling
 
     fig = plot_scaling([{"n_afferents": 1000, "sim_s": 1.0, "wall_s": 0.04},
                         {"n_afferents": 10000, "sim_s": 1.0, "wall_s": 0.3},

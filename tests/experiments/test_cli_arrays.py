@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from experiments.cli import main
-from population import load_dataset
-from population.arrays import save_array
-from population.scenes import Scene, Sites
+from ddmm.experiments.cli import main
+from ddmm.population import load_dataset
+from ddmm.population.io.arrays import save_array
+from ddmm.population.stimuli.scenes import Scene, Sites
 
 
 def run(capsys, *argv):

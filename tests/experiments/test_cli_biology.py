@@ -5,10 +5,10 @@ import json
 import numpy as np
 import pytest
 
-from experiments.calibrate import spec_to_toml
-from experiments.cli import main
-from experiments.decoding import run_decoding, summarise
-from population import load_spec, spec_from_dict
+from ddmm.experiments.calibrate import spec_to_toml
+from ddmm.experiments.cli import main
+from ddmm.experiments.decoding import run_decoding, summarise
+from ddmm.population import load_spec, spec_from_dict
 
 
 def run(capsys, *argv):
@@ -63,7 +63,7 @@ def test_calibrated_spec_round_trips_through_toml(name):
 
 @pytest.mark.slow
 def test_calibration_reproduces_the_committed_preset():
-    from experiments.calibrate import calibrate
+    from ddmm.experiments.calibrate import calibrate
 
     spec, report = calibrate()
     committed = load_spec("fingertip")

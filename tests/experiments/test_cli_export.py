@@ -4,7 +4,7 @@ import sys
 
 import pytest
 
-from experiments.cli import main
+from ddmm.experiments.cli import main
 
 pynwb = pytest.importorskip("pynwb")
 

@@ -2,7 +2,7 @@
 
 import json
 
-from experiments.cli import main
+from ddmm.experiments.cli import main
 
 
 def run(capsys, *argv):
@@ -26,7 +26,7 @@ def test_json_shape_and_figures(capsys, tmp_path):
 def test_table_marks_roles(capsys):
     code, out, _ = run(capsys, "physiology", "--properties", "rest_rate_SAII,force_coding_SAI")
     assert code == 0
-    assert "| rest_rate_SAII | SAII | rest |" in out and "constrained" in out and "held out" in out
+    assert "| rest_rate_SAII | SA-II | rest |" in out and "constrained" in out and "held out" in out
     assert out.strip().splitlines()[-1].startswith("physiology: 2/2 properties pass")
 
 

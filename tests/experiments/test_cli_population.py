@@ -4,9 +4,9 @@ import json
 
 import pytest
 
-from experiments.bench import CASES, run_case
-from experiments.cli import main
-from population import load_dataset
+from ddmm.experiments.bench_cases import CASES, run_case
+from ddmm.experiments.cli import main
+from ddmm.population import load_dataset
 
 
 def run(capsys, *argv):

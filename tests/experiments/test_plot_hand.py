@@ -4,8 +4,10 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-from experiments.plot_hand import hand_counts, plot_hand
-from population import birznieks, hand_map, make_population, sample_population, simulate
+from ddmm.experiments.plot_hand import hand_counts, plot_hand
+from ddmm.models.currents import type_label
+from ddmm.population import birznieks, make_population, sample_population, simulate
+from ddmm.population.anatomy import hand_map
 
 
 @pytest.fixture(scope="module")
@@ -18,7 +20,7 @@ def test_outlines_and_one_scatter_per_type(hand):
     ax = fig.axes[0]
     assert isinstance(fig, Figure) and len(ax.lines) == len(hand_map.REGIONS)
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert labels == [f"{k} ({n})" for k, n in hand.counts().items()]
+    assert labels == [f"{type_label(k)} ({n})" for k, n in hand.counts().items()]
     assert sum(len(c.get_offsets()) for c in ax.collections) == len(hand)
     x0, x1 = ax.get_xlim()
     assert x0 < hand.x_mm.min() and x1 > hand.x_mm.max()

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from experiments.reproduce import FIG8_ANGLES, PROFILES, ReproConfig, reproduce_all, scene_sf
-from population.scenes import birznieks, press_push_lift
+from ddmm.experiments.reproduce import FIG8_ANGLES, PROFILES, ReproConfig, reproduce_all, scene_sf
+from ddmm.population.stimuli.scenes import birznieks, press_push_lift
 
 TYPES = ("SAI", "RAI", "RAII")
 

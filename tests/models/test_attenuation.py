@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from models.attenuation import F_TH, attenuated_force, attenuation_factor
+from ddmm.models.attenuation import F_TH, attenuated_force, attenuation_factor
 
 PROFILES = ["selective", "broad", "bipolar"]
 
@@ -44,7 +44,7 @@ def test_threshold_readings():
 
 
 def test_smooth_reading_is_a_c1_ramp_through_f_th():
-    from models.attenuation import transition_weight
+    from ddmm.models.attenuation import transition_weight
     f_s = np.array([0.0, 0.05, 0.1, 0.15, 0.2, 0.5])
     af = attenuation_factor(np.zeros(6), f_s, [270.0], "selective", no_shear="smooth")[:, 0]
     w = transition_weight(f_s)
@@ -64,7 +64,7 @@ def test_smooth_af_is_continuous_in_the_shear_vector(angle, theta, k, profile, m
 
 
 def test_stretch_drive_of_sa2_falls_against_its_preferred_direction():
-    from models.attenuation import profile_factor, stretch_drive
+    from ddmm.models.attenuation import profile_factor, stretch_drive
     fx, fy = np.zeros(3), np.array([0.0, 1.0, -1.0])
     af = profile_factor(fx, fy, [90.0], "broad", 3.0)
     drive = stretch_drive(fx, fy, af, opponent=0.5)[:, 0]
@@ -80,7 +80,7 @@ def test_cmm_is_af_one():
 def test_profile_radius_never_exceeds_its_tip(phi, k, profile):
     # The geometry itself, not the clip in the AF kernel (which binds only for k < 1):
     # for k >= 1 every profile's boundary is nearest the origin off its tip axis.
-    from models.nap import boundary_radius, tip_radius
+    from ddmm.models.nap import boundary_radius, tip_radius
     r = float(boundary_radius(np.sin(phi), np.cos(phi), profile, k)) / tip_radius(profile)
     assert 0.0 < r <= 1.0 + 1e-12
 

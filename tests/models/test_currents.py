@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from models.currents import CurrentParams, afferent_current, lowpass_sos
+from ddmm.models.currents import CurrentParams, afferent_current, lowpass_sos
 
 FS = 1000.0
 UNIT = CurrentParams(g_sai=1.0, g_rai=1.0, g_raii=1.0)
@@ -102,7 +102,7 @@ def test_bad_rates_and_types():
 def test_filter_kernel_matches_scipy_sosfilt():
     from scipy import signal
 
-    from models.currents import filter_force, initial_filter_state
+    from ddmm.models.currents import filter_force, initial_filter_state
     rng = np.random.default_rng(0)
     f = rng.normal(size=(400, 5)).cumsum(axis=0)
     for order, cutoff in ((2, 20.0), (4, 35.0)):

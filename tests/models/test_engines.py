@@ -1,15 +1,15 @@
 """The engine seam: both engines give identical spikes, and zero input stays silent."""
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-import warnings
-
-from models.engines import NeuronState, SpikeCapWarning, integrate, substeps_for
-from models.pipeline import simulate
+from ddmm.models.engines import NeuronState, SpikeCapWarning, integrate, substeps_for
+from ddmm.models.pipeline import simulate_afferents
 from tests.conftest import ENGINES
 
 TYPES = ("SAI", "RAI", "RAII")
@@ -51,7 +51,7 @@ def test_ten_seconds_of_zero_force_give_no_spikes(engine):
     n = 10_000
     zeros = np.zeros(n)
     for profile in ("selective", "broad", "bipolar", "none"):
-        res = simulate(zeros, zeros, zeros, fs=1000.0, afferent_type=list(TYPES), profile=profile,
+        res = simulate_afferents(zeros, zeros, zeros, fs=1000.0, afferent_type=list(TYPES), profile=profile,
                        theta_t=[0.0, 90.0, 180.0], engine=engine)
         assert res.afferent.size == 0
         assert res.n_steps == n * 10
@@ -109,11 +109,11 @@ def test_pipeline_bad_input(kwargs, match):
                 profile="selective", k=3.0, engine="direct")
     args.update(kwargs)
     with pytest.raises(ValueError, match=match):
-        simulate(args.pop("fx"), args.pop("fy"), args.pop("fz"), **args)
+        simulate_afferents(args.pop("fx"), args.pop("fy"), args.pop("fz"), **args)
 
 
 def test_engines_identical_across_thresholder_blocks():
-    """The Brian2 engine's thresholder scans 64 neurons at a time (`models/brian2_templates/threshold.cpp`).
+    """The Brian2 engine's thresholder scans 64 neurons at a time (`models/engines/brian2/templates/threshold.cpp`).
 
     150 neurons (160 with padding: blocks of 64, 64 and 32) spiking at
     different steps, including the first and last neuron of every block.
@@ -128,7 +128,7 @@ def test_engines_identical_across_thresholder_blocks():
 
 def test_brian2_network_loop_reads_the_clock_once():
     """Brian2's network loop reads the process CPU clock (a system call) after every step; the engine's, once."""
-    from models._brian2_device import EngineCodeObject, drop_per_step_clock
+    from ddmm.models.engines.brian2.device import EngineCodeObject, drop_per_step_clock
 
     def loop(source):
         start = source.index("while(clock")
@@ -143,7 +143,7 @@ def test_brian2_network_loop_reads_the_clock_once():
 
 def test_brian2_refuses_an_input_file_it_could_not_read(monkeypatch):
     """Brian2's binary only prints an error for a run argument's file of the wrong size, and exits 0."""
-    import models.brian2_engine as engine
+    import ddmm.models.engines.brian2.engine as engine
 
     def short_table(path, current, n_samples, n_neurons):
         np.zeros(7).tofile(path)
@@ -160,11 +160,11 @@ def test_brian2_lanes_live_as_long_as_their_process():
     import sys
     from pathlib import Path
 
-    from models._brian2_lanes import _root
+    from ddmm.models.engines.brian2.lanes import _root
 
     stale = _root() / "4194305_0"  # above Linux's largest pid: a process that cannot be alive
     (stale / "results").mkdir(parents=True, exist_ok=True)
-    code = ("import os, numpy as np; from models.engines import integrate; from models._brian2_lanes import _root\n"
+    code = ("import os, numpy as np; from ddmm.models.engines import integrate; from ddmm.models.engines.brian2.lanes import _root\n"
             "for _ in range(2):\n"
             "    integrate(np.full((90, 7), 20.0), fs=1000.0, dt=1e-4, afferent_type='SAI', engine='brian2')\n"
             "mine = sorted(p.name for p in _root().iterdir() if p.name.startswith(f'{os.getpid()}_'))\n"
@@ -179,7 +179,7 @@ def test_brian2_lanes_live_as_long_as_their_process():
 
 def test_brian2_table_is_padded_with_zeros_whatever_the_lane_held(tmp_path):
     """The lane's table file is rewritten in place: padding must not keep an earlier run's values."""
-    from models._brian2_lanes import write_table
+    from ddmm.models.engines.brian2.lanes import write_table
 
     path = tmp_path / "table.dat"
     write_table(path, np.full((8, 4), 7.0), 8, 4)
@@ -193,7 +193,7 @@ def test_brian2_table_is_padded_with_zeros_whatever_the_lane_held(tmp_path):
 
 def test_brian2_lanes_hold_only_small_tables_mapped(tmp_path, monkeypatch):
     """Between runs a lane keeps a small table mapped (cheap to rewrite) but not a long run's."""
-    import models._brian2_lanes as lanes
+    import ddmm.models.engines.brian2.lanes as lanes
 
     monkeypatch.setattr(lanes, "_KEEP_MAPPED", 20)
     small, large = tmp_path / "small.dat", tmp_path / "large.dat"

@@ -1,15 +1,15 @@
-"""The fused pipeline (`models.fused`) against the per-stage functions it fuses: the same bits."""
+"""The fused pipeline (`ddmm.models.fused`) against the per-stage functions it fuses: the same bits."""
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models.attenuation import UNTUNED, attenuated_force, attenuation_factor, profile_factor, stretch_drive
-from models.currents import CurrentParams, current_core
-from models.fused import FusedPlan
-from models.rng import normals as keyed_normals
-from population import load_spec
+from ddmm.models.attenuation import UNTUNED, attenuated_force, attenuation_factor, profile_factor, stretch_drive
+from ddmm.models.currents import CurrentParams, current_core
+from ddmm.models.fused import FusedPipeline
+from ddmm.models.rng import normals as keyed_normals
+from ddmm.population import load_spec
 
 FS = 1000.0
 PHYSIO = load_spec("fingertip").current
@@ -67,7 +67,7 @@ def test_fused_currents_equal_the_stage_by_stage_path(seed, no_shear, physio, no
     key = seed + 1 if noisy else None
     normals = keyed_normals(key, ids, 0, f.shape[0]) if noisy else None
     expected = reference(f, params, no_shear, scale, cv, sigma, theta, k, normals)
-    plan = FusedPlan(TYPES, NAPS, theta, k, scale, cv, sigma, params, FS, no_shear, 0.1, ids)
+    plan = FusedPipeline(TYPES, NAPS, theta, k, scale, cv, sigma, params, FS, no_shear, 0.1, ids)
     state = plan.new_state()
     parts = [plan.currents(f[a:b], state, a > 0, a, key)
              for a, b in ((0, cut), (cut, f.shape[0]))]  # in two chunks: the state carries over
@@ -76,10 +76,10 @@ def test_fused_currents_equal_the_stage_by_stage_path(seed, no_shear, physio, no
 
 @pytest.mark.parametrize("per_slice", [1, 37, 400])
 def test_fused_currents_in_time_slices_equal_the_stage_by_stage_path(monkeypatch, per_slice):
-    """`FusedPlan.currents` cuts long inputs into slices of time that fit in cache; the cut changes no bit."""
-    import models.fused
+    """`FusedPipeline.currents` cuts long inputs into slices of time that fit in cache; the cut changes no bit."""
+    import ddmm.models.fused
 
-    monkeypatch.setattr(models.fused, "_SLICE", per_slice * len(TYPES))
+    monkeypatch.setattr(ddmm.models.fused, "_SLICE", per_slice * len(TYPES))
     rng = np.random.default_rng(11)
     n = len(TYPES)
     theta, k, scale = rng.uniform(0, 360, n), rng.uniform(2.0, 5.0, n), rng.uniform(0.5, 2.0, n)
@@ -87,7 +87,7 @@ def test_fused_currents_in_time_slices_equal_the_stage_by_stage_path(monkeypatch
     f, ids = forces(5), np.arange(n)
     normals = keyed_normals(9, ids, 0, f.shape[0])
     expected = reference(f, PHYSIO, "smooth", scale, cv, sigma, theta, k, normals)
-    plan = FusedPlan(TYPES, NAPS, theta, k, scale, cv, sigma, PHYSIO, FS, "smooth", 0.1, ids)
+    plan = FusedPipeline(TYPES, NAPS, theta, k, scale, cv, sigma, PHYSIO, FS, "smooth", 0.1, ids)
     np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False, 0, 9), expected)
 
 
@@ -113,12 +113,12 @@ def test_fused_currents_equal_the_reference_on_held_directions(no_shear):
     theta, k, scale = rng.uniform(0, 360, n), rng.uniform(2.0, 5.0, n), np.ones(n)
     f = held_forces(3)
     expected = reference(f, PHYSIO, no_shear, scale, np.zeros(n), np.zeros(n), theta, k, None)
-    plan = FusedPlan(TYPES, NAPS, theta, k, scale, np.zeros(n), np.zeros(n), PHYSIO, FS, no_shear, 0.1)
+    plan = FusedPipeline(TYPES, NAPS, theta, k, scale, np.zeros(n), np.zeros(n), PHYSIO, FS, no_shear, 0.1)
     np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False), expected)
 
 
 def test_fused_plan_needs_no_tuned_afferent():
-    plan = FusedPlan(["RAI", "RAI"], ["none", "none"], [0.0, 0.0], [3.0, 3.0], [1.0, 1.0], [0.0, 0.0], [0.0, 0.0],
+    plan = FusedPipeline(["RAI", "RAI"], ["none", "none"], [0.0, 0.0], [3.0, 3.0], [1.0, 1.0], [0.0, 0.0], [0.0, 0.0],
                      PHYSIO, FS, "smooth", 0.1)
     f = forces(1)
     expected, _ = current_core(np.column_stack([f[:, 2], f[:, 2]]), FS, "RAI", PHYSIO, None, np.ones(2))
@@ -127,19 +127,19 @@ def test_fused_plan_needs_no_tuned_afferent():
 
 @pytest.mark.parametrize("method", ["euler", "rk4"])
 def test_fused_spikes_equal_the_direct_engine(method):
-    from models.direct import _BLOCK, _METHOD_CODES
-    from models.engines import integrate
-    from models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
+    from ddmm.models.engines import integrate
+    from ddmm.models.engines.direct import BLOCK, METHOD_CODES
+    from ddmm.models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
 
-    plan = FusedPlan(TYPES, NAPS, np.linspace(0, 330, len(TYPES)), np.full(len(TYPES), 3.0), np.full(len(TYPES), 2.0),
+    plan = FusedPipeline(TYPES, NAPS, np.linspace(0, 330, len(TYPES)), np.full(len(TYPES), 3.0), np.full(len(TYPES), 2.0),
                      np.zeros(len(TYPES)), np.zeros(len(TYPES)), PHYSIO, FS, "smooth", 0.1)
     f = forces(2)
     current = plan.currents(f, plan.new_state(), False)
     res = integrate(current, fs=FS, dt=1e-4, afferent_type=np.array(TYPES), engine="direct", method=method)
     p = neuron_arrays(np.array(TYPES))
     v, u = (np.array(x, dtype=float) for x in resting_state(p["b"]))
-    neuron = (10, _METHOD_CODES[method], 1.0 * 1e-4 / 0.001, (1.0 * (0.5 * 1e-4)) / 0.001, p["a"], p["b"], p["c"],
-              p["d"], V_PEAK, V_FLOOR, _BLOCK)
+    neuron = (10, METHOD_CODES[method], 1.0 * 1e-4 / 0.001, (1.0 * (0.5 * 1e-4)) / 0.001, p["a"], p["b"], p["c"],
+              p["d"], V_PEAK, V_FLOOR, BLOCK)
     _, afferent, step, _, finite, capped = plan.spikes(f, plan.new_state(), False, 0, None, neuron, v, u)
     assert finite and not capped and afferent.size > 10
     order = np.lexsort((afferent, step))

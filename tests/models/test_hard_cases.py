@@ -7,9 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models.engines import NumericalInstabilityError, SpikeCapWarning, integrate
-from models.neuron import V_FLOOR
-from models.pipeline import simulate as simulate_afferents
+from ddmm.models.engines import NumericalInstabilityError, SpikeCapWarning, integrate
+from ddmm.models.neuron import V_FLOOR
+from ddmm.models.pipeline import simulate_afferents
 from tests.conftest import ENGINES
 
 TYPES = ["SAI", "RAI", "RAII"]
@@ -27,7 +27,7 @@ def test_strong_input_at_1ms_is_finite_and_warns_when_capped(engine):
 @pytest.mark.parametrize("order", ["by_time", "by_neuron_descending_time"])
 def test_cap_check_finds_consecutive_spikes_in_any_order(order):
     """`check_integration` scans in one pass when each neuron's spikes come in time order, and sorts when not."""
-    from models.engines import check_integration
+    from ddmm.models.engines import check_integration
 
     neuron, step = np.array([0, 1, 1, 2]), np.array([3, 7, 8, 20])
     if order != "by_time":
@@ -119,7 +119,7 @@ def test_brian2_does_not_take_over_python_warnings():
     import logging
     import subprocess
     import sys
-    code = ("import warnings; from models.engines import prepare; prepare('brian2');"
+    code = ("import warnings; from ddmm.models.engines import prepare; prepare('brian2');"
             "import logging, brian2;"
             "w = warnings.catch_warnings(record=True); rec = w.__enter__(); warnings.simplefilter('always');"
             "warnings.warn('mine', UserWarning); print(len(rec), logging.getLogger('py.warnings').handlers == [] or 'captured')")
@@ -129,7 +129,7 @@ def test_brian2_does_not_take_over_python_warnings():
 
 
 def test_brian2_log_warnings_become_python_warnings():
-    from models.brian2_engine import Brian2Warning, _import_brian2
+    from ddmm.models.engines.brian2.engine import Brian2Warning, _import_brian2
     _import_brian2()
     import logging
     with pytest.warns(Brian2Warning, match="test message"):

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from models.metrics import direction_index, spiking_frequency
+from ddmm.models.metrics import direction_index, spiking_frequency
 
 
 def test_direction_index_analytic():

@@ -1,13 +1,12 @@
-"""NAP geometry: closed-form radii against the notes' table and a numerical ray scan."""
+"""NAP geometry: closed-form radii against the table of docs/model.md §1.2 and a numerical ray scan."""
 
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from experiments.reference import PAPER_RADII_K3
-from models.nap import (PROFILES, boundary_radius, get_profile, k_from_selectivity,
-                        selectivity_from_k, tip_radius)
+from ddmm.experiments.paper_values import PAPER_RADII_K3
+from ddmm.models.nap import PROFILES, boundary_radius, get_profile, k_from_selectivity, selectivity_from_k, tip_radius
 
 
 def implicit(x, y, prof, k):

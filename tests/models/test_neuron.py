@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from models.neuron import NEURON_PARAMS, neuron_arrays, resting_state
+from ddmm.models.neuron import NEURON_PARAMS, neuron_arrays, resting_state
 
 
 def test_types_follow_the_paper():

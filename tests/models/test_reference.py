@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from models.neuron import neuron_arrays, resting_state
-from models.reference import reference_spike_times
+from ddmm.models.neuron import neuron_arrays, resting_state
+from ddmm.models.reference_solver import reference_spike_times
 
 
 def ivp_spike_times(current, fs, a, b, c, d, v, u):

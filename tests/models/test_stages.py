@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models.currents import CurrentParams, afferent_current, check_fs, current_core
-from population import load_spec
+from ddmm.models.currents import CurrentParams, afferent_current, check_fs, current_core
+from ddmm.population import load_spec
 
 FS = 1000.0
 #: The physiological stages of the presets (population/presets/fingertip.toml).

@@ -3,9 +3,15 @@
 import numpy as np
 import pytest
 
-from population import sample_population, simulate
-from population.array_decode import CentroidClassifier, SlipDetector, evaluate_slip, onset_counts, stage_onset
-from population.site_scenes import incipient_slip, torsion
+from ddmm.population import sample_population, simulate
+from ddmm.population.analysis.array_decode import (
+    CentroidClassifier,
+    SlipDetector,
+    evaluate_slip,
+    onset_counts,
+    stage_onset,
+)
+from ddmm.population.stimuli.site_scenes import incipient_slip, torsion
 
 
 def test_centroid_classifier_weights_features_by_their_spread():

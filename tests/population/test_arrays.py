@@ -7,9 +7,9 @@ import xarray as xr
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from population import arrays
-from population.arrays import default_radius, from_array, from_long_csv, save_array
-from population.scenes import Contact, Scene, Sites, birznieks, taxel_radius
+from ddmm.population.io import arrays
+from ddmm.population.io.arrays import default_radius, from_array, from_long_csv, save_array
+from ddmm.population.stimuli.scenes import Contact, Scene, Sites, birznieks, taxel_radius
 
 EXTS = (".npz", ".nc", ".h5", ".hdf5")
 

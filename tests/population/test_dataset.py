@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from population import binned_counts, birznieks, make_population, psth, simulate
+from ddmm.population import binned_counts, birznieks, make_population, psth, simulate
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +49,7 @@ def test_rates_need_events(ds):
 def test_events_sort_like_lexsort(events, n_steps_bound):
     """Each path of the event sort (counting sorts for few time slots, the packed key, lexsort when the key
     would overflow) orders like lexsort and counts like bincount."""
-    from population.dataset import _sorted_events
+    from ddmm.population.dataset import _sorted_events
 
     cond, trial, step, aff = (np.array([e[i] for e in events], np.int64) for i in range(4))
     step %= n_steps_bound

@@ -3,9 +3,15 @@
 import numpy as np
 import pytest
 
-from population import birznieks, make_population, sample_population, simulate
-from population.decode import (FirstSpikeLatency, MaximumLikelihood, PopulationVector, angular_error,
-                               select_afferents, window_responses)
+from ddmm.population import birznieks, make_population, sample_population, simulate
+from ddmm.population.analysis.decode import (
+    FirstSpikeLatency,
+    MaximumLikelihood,
+    PopulationVector,
+    angular_error,
+    select_afferents,
+    window_responses,
+)
 
 from .synthetic import cosine_dataset
 
@@ -44,7 +50,7 @@ def test_latency_decoder_on_cosine_latencies():
 
 
 def test_bipolar_afferents_are_axial_in_the_population_vector():
-    from population.decode import population_vector
+    from ddmm.population.analysis.decode import population_vector
     # a bipolar afferent on the Y axis and a weak unipolar one pointing +Y: the axis resolves to +Y
     est = population_vector([[10.0, 1.0]], [90.0, 90.0], ["bipolar", "selective"], 0.0, 1.0)
     assert np.rad2deg(est[0]) == pytest.approx(90.0)

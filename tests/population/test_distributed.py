@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from distributed import Client, LocalCluster
 
-from models.engines import SpikeCapWarning
-from population import birznieks, press_push_lift, sample_population, simulate
+from ddmm.models.engines import SpikeCapWarning
+from ddmm.population import birznieks, press_push_lift, sample_population, simulate
 
 
 @pytest.fixture(scope="module")
@@ -37,7 +37,7 @@ def test_bit_identical_to_in_process(client, pop, engine):
 
 
 def test_multi_site_runs_are_identical_on_workers(client, pop):
-    from population.site_scenes import torsion
+    from ddmm.population.stimuli.site_scenes import torsion
 
     scenes = [torsion(5.0, 3.0, direction=d, hold_s=0.1, name=f"t{d}") for d in (1, -1)]
     ref = simulate(pop, scenes, engine="direct", seed=4, trials=2, quiet=True)

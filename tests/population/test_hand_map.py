@@ -8,10 +8,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models.currents import AFFERENT_TYPES
-from population import hand_map, load_spec, make_population, sample_population
-from population.hand_map import REGIONS, Ellipse, HandRegion, Polygon
-from population.sampling import _ARRAYS, Population
+from ddmm.models.currents import AFFERENT_TYPES
+from ddmm.population import load_spec, make_population, sample_population
+from ddmm.population.anatomy import hand_map
+from ddmm.population.anatomy.hand_map import REGIONS, Ellipse, HandRegion, Polygon
+from ddmm.population.sampling import _ARRAYS, Population
 
 #: sha256 of the fingertip population's arrays (seeds 0 and 7) computed at commit 7ab7004, before the map.
 FINGERTIP_SHA = {0: "3b8abd6905ac588cb1795297f86a238418a75bfa305272e03704263397ea2cf8",
@@ -152,7 +153,7 @@ def test_select_carries_region_and_frame(hand):
 
 
 def test_map_subset_samples_only_those_regions():
-    from population import spec_from_dict
+    from ddmm.population import spec_from_dict
 
     spec = spec_from_dict({"types": {"RAI": {}}, "map": {"regions": ["D1d", "hypothenar"]}})
     pop = sample_population(spec, rng=3)

@@ -9,9 +9,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models.attenuation import F_TH
-from models.engines import SpikeCapWarning
-from population import Scene, birznieks, from_csv, make_population, sample_population, simulate
+from ddmm.models.attenuation import F_TH
+from ddmm.models.engines import SpikeCapWarning
+from ddmm.population import Scene, birznieks, from_csv, make_population, sample_population, simulate
 from tests.conftest import ENGINES
 
 

@@ -5,7 +5,7 @@ import sys
 import numpy as np
 import pytest
 
-from population import birznieks, psth, sample_population, simulate, to_neo
+from ddmm.population import birznieks, psth, sample_population, simulate, to_neo
 
 pytestmark = pytest.mark.filterwarnings("ignore:The 'copy' argument in Quantity is deprecated")  # elephant 1.2
 

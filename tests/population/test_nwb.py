@@ -10,8 +10,8 @@ from datetime import datetime, timezone
 import numpy as np
 import pytest
 
-from experiments.cli import main
-from population import Scene, Sites, birznieks, load_dataset, sample_population, simulate, to_nwb
+from ddmm.experiments.cli import main
+from ddmm.population import Scene, Sites, birznieks, load_dataset, sample_population, simulate, to_nwb
 
 pynwb = pytest.importorskip("pynwb")
 
@@ -123,7 +123,7 @@ def test_schema_comes_from_the_installed_package_and_nothing_goes_online(nc, tmp
                 opened.append(os.path.realpath(args[0]))
         sys.addaudithook(hook)
         import pynwb, hdmf
-        from population import Scene, Sites, birznieks, load_dataset, sample_population, simulate, to_nwb
+        from ddmm.population import Scene, Sites, birznieks, load_dataset, sample_population, simulate, to_nwb
         to_nwb(load_dataset({str(nc)!r}), {str(tmp_path / "o.nwb")!r})
         assert pynwb.validate(path={str(tmp_path / "o.nwb")!r}) == []
         try:

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from experiments.reference import PHYSIOLOGY_REFERENCE
-from population import Scene, make_population, sample_population, simulate
-from population.physiology import PROPERTIES, Reference, score_physiology, summarise_scorecard
+from ddmm.experiments.paper_values import PHYSIOLOGY_REFERENCE
+from ddmm.population import Scene, make_population, sample_population, simulate
+from ddmm.population.analysis.physiology import PROPERTIES, Reference, score_physiology, summarise_scorecard
 
 
 @pytest.fixture(scope="module")

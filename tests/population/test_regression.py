@@ -1,58 +1,83 @@
 """Spikes, currents and noise frozen across optimisations: stored digests of one run.
 
 The fused path is held to the per-stage functions bit for bit, but both run
-through shared kernels (`models._stage_kernels`, `models.rng`); a change to
-those would move both together.  This digest was recorded at 1add058 and
-still holds after the kernels were rewritten for speed, so every such
-rewrite must keep the spikes.  numpy's transcendental functions may differ
-in the last bit between SIMD targets, so the digest is checked only on the
-CPU features it was recorded with.
+through shared kernels (`ddmm.models._stage_kernels`, `ddmm.models.rng`); a
+change to those would move both together.  So one run's spikes and
+noise-free currents are stored as digests (the spikes' since 1add058), and
+every rewrite of the kernels must keep them.  Spikes move only when a change
+crosses a 0.1 ms step, so the bits of the currents and of the noise are
+pinned too.
+
+Why the run is made under pinned dispatch
+-----------------------------------------
+The currents' last bits depend on the instruction sets a host dispatches
+to: numpy's SIMD log1p, tanh, sin, tan, ... (AVX2, AVX512_SKX), glibc's FMA
+variants of exp, log, sin, cos, tan, atan, log1p and tanh (which numpy's
+baseline loops and random generators call) and OpenBLAS's per-core dot
+products.  A digest recorded under one instruction set can be checked only
+on hosts that have it, and a digest recomputed by the code under test can
+catch no regression.  So the run is made in a child process
+(`tests.population._pinned_digest`) whose environment pins every one of
+them to what any x86-64 host has: numba's generic target, numpy's baseline
+loops, glibc's SSE2 libm, OpenBLAS's SSE3 kernels, all from empty caches.
+The digests recorded there hold on every x86-64 Linux host and are never
+skipped.
+
+The noise is integer arithmetic and one multiply per draw, the same on
+every machine, so it is checked in this process.
 """
 
 import hashlib
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
 
 import numpy as np
-import pytest
 
-from models.rng import normals, stream_key
-from population import birznieks, sample_population, simulate
-from population.simulate import population_currents
+import ddmm
+from ddmm.models.rng import normals, stream_key
 
-DIGEST = "41521a8f0e54d2ae38e7f186d55e36a2be78dab81138bf563d973eb4d4b0148d"
-N_SPIKES = 19849
-#: Spikes move only when a change crosses a 0.1 ms step, so the bits of the
-#: noise-free currents and of the noise are pinned too.
-CURRENTS_DIGEST = "29b186933210336865916a89d75d7b7f03d959cfb0efa4cf2af0927db07f476f"
+from . import _pinned_digest
+from ._pinned_digest import AFFERENTS, pinned_env
+
+#: Digests of the run under pinned dispatch (`_pinned_digest.run_digests`).  The spikes' are also
+#: what every host's own dispatch gave, on every instruction set tried; the currents' are not.
+RECORDED = {
+    "spikes": "41521a8f0e54d2ae38e7f186d55e36a2be78dab81138bf563d973eb4d4b0148d",
+    "n_spikes": 19849,
+    "currents": "24d8967e10ffb1590fdd73803045c4f0387b07732941418788cb0f26f9cec09b",
+}
+#: Where they were recorded: the bits of libm and of numpy's baseline loops are the platform's.
+RECORDED_ON = "x86_64 Linux, glibc 2.36, numpy 2.3 (baseline SSE SSE2 SSE3)"
 NOISE_DIGEST = "46fec17f2e6c2c67e82d6b0432fd9c1f236a389244c9247f025a0d62b1e67bde"
-AFFERENTS = np.arange(0, 991, 3)
-RECORDED_ON = "AVX512_SKX"  # numpy's dispatch target where DIGEST was recorded
 
 
-def _recorded_target() -> bool:
-    from numpy._core._multiarray_umath import __cpu_features__
-
-    return bool(__cpu_features__.get(RECORDED_ON))
-
-
-@pytest.mark.skipif(not _recorded_target(), reason=f"digest recorded on {RECORDED_ON}; numpy's SIMD log1p/tanh "
-                                                    "may differ in the last bit elsewhere")
-def test_spikes_equal_the_recorded_digest():
-    pop = sample_population("fingertip", rng=0).select(AFFERENTS)
-    ds = simulate(pop, [birznieks(30.0), birznieks(200.0)], engine="direct", seed=5, trials=2, quiet=True)
-    digest = hashlib.sha256()
-    for name in ("spike_time", "spike_afferent", "spike_trial", "spike_condition", "spike_count"):
-        digest.update(ds[name].values.tobytes())
-    assert ds.sizes["spike"] == N_SPIKES
-    assert digest.hexdigest() == DIGEST
+def _pinned_run() -> dict:
+    """The child's digests and what it ran with (about 15 s, most of it numba compiling from an empty cache)."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = pinned_env(cache)
+        # The child imports the ddmm this process imported (a source checkout or an installed copy).
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(Path(ddmm.__file__).resolve().parents[1]),
+                                                          env.get("PYTHONPATH")]))
+        done = subprocess.run([sys.executable, _pinned_digest.__file__], env=env, capture_output=True, text=True,
+                              check=False, timeout=600)
+    assert done.returncode == 0, f"the pinned run failed:\n{done.stderr}"
+    return json.loads(done.stdout.splitlines()[-1])
 
 
-@pytest.mark.skipif(not _recorded_target(), reason=f"digest recorded on {RECORDED_ON}")
-def test_currents_equal_the_recorded_digest():
-    pop = sample_population("fingertip", rng=0).select(AFFERENTS)
-    assert hashlib.sha256(population_currents(pop, birznieks(30.0)).tobytes()).hexdigest() == CURRENTS_DIGEST
+def test_spikes_and_currents_under_pinned_dispatch_equal_the_recorded_digests():
+    """One child run (one test, so that pytest-xdist never starts two): the pins took effect, then the digests."""
+    run = _pinned_run()
+    assert (run["numba_cpu_name"], run["numba_cpu_features"], run["numpy_dispatch"]) == ("generic", "", [])
+    host = f"{platform.machine()} {platform.system()}, {' '.join(platform.libc_ver())}, numpy {np.__version__}"
+    assert {key: run[key] for key in RECORDED} == RECORDED, f"recorded on {RECORDED_ON}; this host: {host}"
 
 
 def test_noise_equals_the_recorded_digest():
     """Integer arithmetic and one multiply per draw on the fast path: the same on every machine."""
-    values = normals(stream_key(5, 1, 2), AFFERENTS, 0, 1000)
+    values = normals(stream_key(5, 1, 2), np.asarray(AFFERENTS), 0, 1000)
     assert hashlib.sha256(values.tobytes()).hexdigest() == NOISE_DIGEST

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from models.nap import selectivity_from_k
-from population.sampling import make_population, sample_population
-from population.spec import load_spec, spec_from_dict
+from ddmm.models.nap import selectivity_from_k
+from ddmm.population.sampling import make_population, sample_population
+from ddmm.population.spec import load_spec, spec_from_dict
 
 
 def test_same_seed_same_population_and_different_seed_differs():
@@ -72,7 +72,7 @@ def test_select_keeps_ids_and_make_population_validates():
 def test_sampling_does_not_depend_on_the_hash_seed():
     import subprocess
     import sys
-    code = "from population import sample_population; print(sample_population('fingertip', rng=0).k.sum().hex())"
+    code = "from ddmm.population import sample_population; print(sample_population('fingertip', rng=0).k.sum().hex())"
     outs = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                            env={**__import__("os").environ, "PYTHONHASHSEED": str(h)}).stdout for h in (1, 2, 3)}
     assert len(outs) == 1

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from population.scenes import Contact, Scene, birznieks, from_csv, press_push_lift, rotating_shear
+from ddmm.population.stimuli.scenes import Contact, Scene, birznieks, from_csv, press_push_lift, rotating_shear
 
 
 def test_birznieks():

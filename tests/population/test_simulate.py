@@ -4,8 +4,17 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from population import (Contact, birznieks, load_dataset, make_population, plan_run, press_push_lift,
-                        sample_population, save_dataset, simulate)
+from ddmm.population import (
+    Contact,
+    birznieks,
+    load_dataset,
+    make_population,
+    plan_run,
+    press_push_lift,
+    sample_population,
+    save_dataset,
+    simulate,
+)
 
 SCHEMA_COORDS = {"afferent", "afferent_type", "theta_t", "nap", "k", "gain", "x_mm", "y_mm", "noise_sigma",
                  "region", "frame_deg", "condition", "duration", "theta_r", "has_theta_r", "trial", "time"}
@@ -170,7 +179,7 @@ def test_same_seed_same_spikes_across_processes():
     import os
     import subprocess
     import sys
-    code = ("from population import sample_population, simulate, birznieks; import hashlib;"
+    code = ("from ddmm.population import sample_population, simulate, birznieks; import hashlib;"
             "ds = simulate(sample_population('fingertip', rng=0).select(range(0, 991, 5)), birznieks(30.0),"
             " engine='direct', seed=3, quiet=True);"
             "print(hashlib.sha256(ds.spike_time.values.tobytes() + ds.spike_afferent.values.tobytes()).hexdigest())")

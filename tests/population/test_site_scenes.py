@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from population.site_scenes import contact_grid, incipient_slip, torsion
+from ddmm.population.stimuli.site_scenes import contact_grid, incipient_slip, torsion
 
 
 @settings(max_examples=20, deadline=None)
@@ -75,8 +75,8 @@ def test_slip_control_never_slips():
 
 
 def test_grasp_shares_the_load_and_grips_above_the_slip_limit():
-    from population.hand_map import get_region
-    from population.site_scenes import grasp
+    from ddmm.population.anatomy.hand_map import get_region
+    from ddmm.population.stimuli.site_scenes import grasp
 
     s = grasp(("D1", "D2", "D3", "D4", "D5"), load_n=2.5, mu=0.8, safety=1.4)
     f = s.site_forces

@@ -5,11 +5,17 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from population import Contact, Scene, Sites, birznieks, sample_population, simulate, taxel_radius
-from population.simulate import population_currents
-from population.spatial import (REFERENCE_AREA_MM2, RF_AREA_MM2, RF_SIGMA_MM, local_mixing, receptive_field_weight,
-                                site_coverage)
-from population.stream import Encoder
+from ddmm.population import Contact, Scene, Sites, birznieks, sample_population, simulate, taxel_radius
+from ddmm.population.anatomy.receptive_fields import (
+    REFERENCE_AREA_MM2,
+    RF_AREA_MM2,
+    RF_SIGMA_MM,
+    local_mixing,
+    receptive_field_weight,
+    site_coverage,
+)
+from ddmm.population.runtime.stream import Encoder
+from ddmm.population.simulation import population_currents
 from tests.conftest import ENGINES
 
 R_REF = float(np.sqrt(REFERENCE_AREA_MM2 / np.pi))
@@ -64,7 +70,7 @@ def test_local_mixing_is_a_weighted_mean_of_tractions():
 def test_afferents_either_side_of_a_twist_feel_opposite_shear(pop):
     sc = twist()
     indptr, indices, coeff, cover = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, sc.sites)
-    from models.fused import mix_forces, mixing_matrix
+    from ddmm.models.fused import mix_forces, mixing_matrix
 
     local = mix_forces(sc.site_forces[200:201], mixing_matrix(indptr, indices, coeff, 2))[0].T
     sai = (pop.afferent_type == "SAI") & (cover > 0)
@@ -147,7 +153,7 @@ def test_a_push_on_d2_leaves_d4_and_the_palm_silent(hand):
     base = birznieks(90.0)
     f = np.stack([base.fx, base.fy, base.fz], axis=1)[:, None, :]
     sc = Scene.from_sites(f, Sites([0.0], [0.0], R_REF, region=["D2d"], site_id=["D2tip"]), base.fs, "d2push")
-    from population import plan_run
+    from ddmm.population import plan_run
 
     text = plan_run(hand, [sc]).describe(hand, [sc])
     ds = simulate(hand, sc, engine="direct", seed=0, quiet=True)

@@ -2,9 +2,9 @@
 
 import pytest
 
-from experiments.reference import TOUCHSIM_COUNTS
-from population import hand_map
-from population.spec import load_spec, spec_from_dict
+from ddmm.experiments.paper_values import TOUCHSIM_COUNTS
+from ddmm.population.anatomy import hand_map
+from ddmm.population.spec import load_spec, spec_from_dict
 
 
 def test_fingertip_has_touchsim_counts_plus_sa2_at_the_row_16_ratio():

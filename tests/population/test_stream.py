@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from population import Scene, press_push_lift, sample_population, simulate
-from population.stream import Encoder
+from ddmm.population import Scene, press_push_lift, sample_population, simulate
+from ddmm.population.runtime.stream import Encoder
 from tests.conftest import ENGINES
 
 N = 3000
@@ -40,9 +40,9 @@ def test_any_chunking_equals_offline(setup, cuts, engine):
 @pytest.mark.parametrize("threads", ["2", "3"])
 def test_parallel_push_equals_offline(setup, monkeypatch, threads):
     """A large population's pushes integrate on several numba threads: the spikes stay the offline ones."""
-    import population.stream as stream
+    from ddmm.models.engines import get_engine
 
-    monkeypatch.setattr(stream, "PARALLEL_MIN_AFFERENTS", 1)
+    monkeypatch.setattr(get_engine("direct"), "parallel_min_afferents", 1)
     monkeypatch.setenv("DDMM_NUM_THREADS", threads)
     pop, forces, offline = setup
     enc = Encoder(pop, 1000.0, engine="direct", seed=3)
@@ -93,7 +93,7 @@ def test_encoder_bad_arguments(setup):
 def test_cli_stream(capsys, monkeypatch):
     import io
 
-    from experiments.cli import main
+    from ddmm.experiments.cli import main
     t = np.arange(0, 0.3, 0.001)
     fz = np.interp(t, [0, 0.1, 0.3], [0, 4, 4])
     lines = ["t,fx,fy,fz"] + [f"{a:.3f},0,{0.3 * b:.4f},{b:.4f}" for a, b in zip(t, fz)] + ["0.1,0,0,1", "x"]
@@ -109,8 +109,8 @@ def test_the_spike_cap_warning_survives_the_fused_path():
     """A drive far past the step rate warns offline and when streamed (the fused kernel flags it)."""
     import warnings
 
-    from models.engines import SpikeCapWarning
-    from population import birznieks, make_population
+    from ddmm.models.engines import SpikeCapWarning
+    from ddmm.population import birznieks, make_population
 
     pop = make_population(["SAI"] * 3, gain=1e4)
     scene = birznieks(90.0)

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from population import make_population, sample_population, simulate
-from population.tuning import _anova_p, direction_tuning, tuning_scenes, tuning_summary
+from ddmm.population import make_population, sample_population, simulate
+from ddmm.population.analysis.tuning import _anova_p, direction_tuning, tuning_scenes, tuning_summary
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +38,7 @@ def test_anova_degenerate_and_regular_cases():
 def test_false_positive_rate_of_the_criterion_in_use():
     # The criterion is "tuned if either phase is significant": on null data it flags
     # 1 - 0.95^2 = 9.75% of afferents, not 5%; Bonferroni brings it to <= 5%.
-    from population.tuning import tuned_criterion
+    from ddmm.population.analysis.tuning import tuned_criterion
     rng = np.random.default_rng(1)
     p = np.stack([_anova_p(rng.poisson(10, size=(5, 5, 20000)).astype(float)) for _ in range(2)])
     assert np.mean(tuned_criterion(p)) == pytest.approx(0.0975, abs=0.006)
@@ -52,8 +52,8 @@ def test_summary_reports_absent_types(known):
 
 
 def test_fingertip_preset_meets_the_calibration_targets_over_five_seeds():
-    from experiments.calibrate import validate
-    from population import load_spec
+    from ddmm.experiments.calibrate import validate
+    from ddmm.population import load_spec
 
     stats = validate(load_spec("fingertip"), scorecard=False)["mean_sd"]
     assert abs(stats["tuned_fraction.recorded"][0] - 0.86) <= 0.03  # held out: SA-I + SA-II + FA-I

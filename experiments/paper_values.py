@@ -1,0 +1,140 @@
+"""Published reference numbers, each with its source, in one place.
+
+Experiments print our values beside these; tests check against them.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "PAPER_RADII_K3",
+    "PAPER_TABLE2",
+    "PAPER_TABLE3",
+    "HUMAN_DSI",
+    "HUMAN_TUNED_FRACTION",
+    "HUMAN_DIRECTION_THRESHOLD_DEG",
+    "TOUCHSIM_COUNTS",
+    "TOUCHSIM_SPEED",
+    "PHYSIOLOGY_REFERENCE",
+]
+
+#: NAP boundary radii at k = 3 for phi = 0, 15, 30, 45, 60, 90, 120, 150, 165,
+#: 180 deg (docs/model.md §1.2; tests/models/test_nap.py checks them by scanning rays numerically).
+PAPER_RADII_K3 = {
+    "phi_deg": (0, 15, 30, 45, 60, 90, 120, 150, 165, 180),
+    "bipolar": (1.000, 0.574, 0.423, 0.354, 0.323, 0.333, 0.323, 0.423, 0.574, 1.000),
+    "selective": (1.000, 0.574, 0.423, 0.354, 0.323, 0.200, 0.146, 0.146, 0.163, 0.200),
+    "broad": (0.867, 0.708, 0.315, 0.141, 0.095, 0.067, 0.065, 0.085, 0.115, 0.200),
+}
+
+#: Paper Table II: PRSI (eq. 19) on the Birznieks scene, theta_R = 90 deg, k = 3.
+PAPER_TABLE2 = {
+    "selective": {"SAI": 0.38, "RAI": 0.31, "RAII": 0.33},
+    "broad": {"SAI": 0.45, "RAI": 0.36, "RAII": 0.33},
+    "bipolar": {"SAI": 0.0, "RAI": 0.0, "RAII": 0.0},
+    "cmm": {"SAI": 0.0, "RAI": 0.0, "RAII": 0.0},
+}
+
+#: Paper Table III: SF (pulses/s) at theta_T = 75 / 255 deg on press-push-lift.
+PAPER_TABLE3 = {
+    "selective": {"SAI": (37.5, 15.0), "RAI": (17.5, 7.5), "RAII": (15.0, 7.5)},
+    "broad": {"SAI": (47.5, 10.0), "RAI": (20.0, 7.5), "RAII": (20.0, 7.5)},
+    "bipolar": {"SAI": (37.5, 37.5), "RAI": (17.5, 17.5), "RAII": (15.0, 15.0)},
+    "cmm": {"SAI": (47.5, 47.5), "RAI": (15.0, 15.0), "RAII": (10.0, 10.0)},
+}
+
+#: Human DSI (eq. 7), mean and SD, Birznieks et al. 2001 as the paper reports it.
+HUMAN_DSI = {"SAI": (0.23, 0.18), "RAI": (0.24, 0.18)}
+
+#: Fraction of afferents significantly direction tuned, Birznieks et al. 2001
+#: (5 force directions; as reported in the paper's introduction).
+HUMAN_TUNED_FRACTION = {"all": 0.86, "SAI": 0.93, "RAI": 0.83}
+
+#: Human discrimination threshold for force direction in the tangential plane
+#: (Panarese & Edin 2011), degrees.
+HUMAN_DIRECTION_THRESHOLD_DEG = 7.1
+
+#: TouchSim's populations (Saal et al. 2017): index fingertip pad and whole hand.
+TOUCHSIM_COUNTS = {
+    "fingertip": {"SAI": 282, "RAI": 573, "RAII": 100},
+    "hand": {"SAI": 3658, "RAI": 6956, "RAII": 1905},
+}
+
+#: TouchSim (Python port) and ddmm measured side by side on one 2-core host of this
+#: machine kind (hosts of the kind differ by more than 2x: compare only within a row):
+#: TouchSim hand x 1 s at 5 kHz, its peak memory and its import-to-first-result time,
+#: against `ddmm bench`'s hand x 1 s direct case and its integration kernel alone.
+TOUCHSIM_SPEED = {
+    "hand_wall_s": 6.71,
+    "hand_peak_gb": 2.7,
+    "import_to_first_result_s": 3.6,
+    "ddmm_hand_1s_direct_wall_s": (0.23, 0.27),
+    "ddmm_hand_1s_kernel_s": 0.146,
+}
+
+
+def _physiology_reference() -> dict:
+    """Reference ranges of the physiology scorecard (`ddmm.population.analysis.physiology`), from docs/references.md.
+
+    Rows marked R there are recalled, not read: they become broad ranges here.
+    Roles: ``fitted`` (an objective of ``ddmm calibrate``), ``constrained``
+    (bounds the calibration or was set by hand from it), ``held out`` (never in
+    any objective or hand setting).
+    """
+    from ddmm.population.analysis.physiology import Reference as R
+
+    inf = float("inf")
+    rest = "docs/references.md row 1 (Vallbo & Johansson 1984; Knibestol 1975); row 2 (foot sole, V)"
+    onoff = "docs/references.md rows 3-5 (Westling & Johansson 1987; J Neurosci 3:2652)"
+    rates = "docs/references.md row 5: no afferent sustains rates near 1 kHz; bar 500 pulses/s"
+    tuned = "docs/references.md rows 10-11 (Birznieks et al. 2001 via the DDMM paper)"
+    return {
+        "rest_rate_RAI": R(0.0, 0.0, rest, "constrained", "R"),
+        "rest_rate_RAII": R(0.0, 0.0, rest, "constrained", "R"),
+        "rest_rate_SAI": R(0.0, 1.0, rest, "constrained", "R"),
+        "rest_silent_SAI": R(0.9, 1.0, rest, "constrained", "R"),
+        "rest_rate_SAII": R(5.0, 20.0, rest + "; SA-II bias set by hand to it", "constrained", "R"),
+        "hold_ratio_RAI": R(0.0, 0.1, onoff, "constrained", "R"),
+        "release_fraction_RAI": R(0.5, 1.0, onoff, "constrained", "R"),
+        "off_transient_RAII": R(0.0, 0.0, onoff + ": FA-II fire only at transients (within 100 ms)", "constrained", "R"),
+        "hold_rate_SAI": R(10.0, 60.0, "docs/references.md row 5: SA-I plateau 10-60 imp/s, 2-4 N", "constrained", "R"),
+        "adaptation_SAI": R(0.0, 0.99, "docs/references.md row 4: SA adapt in a hold (V, monkey)", "constrained", "V"),
+        "max_rate_SAI": R(0.0, 500.0, rates, "constrained", "R"),
+        "max_rate_RAI": R(0.0, 500.0, rates, "constrained", "R"),
+        "max_rate_RAII": R(0.0, 500.0, rates, "constrained", "R"),
+        "max_rate_SAII": R(0.0, 500.0, rates, "constrained", "R"),
+        "capped_spikes": R(0.0, 0.0, "nothing near one spike per integration step", "constrained", "R"),
+        "force_coding_SAI": R(1.05, inf, "docs/references.md row 6: SA-I rates rise with normal force (shape only)",
+                              "held out", "V"),
+        "rate_coding_RAI": R(1.05, inf, "docs/references.md row 6: FA-I responses grow with indentation rate",
+                             "held out", "V"),
+        "best_frequency_RAI": R(8.0, 64.0, "docs/references.md row 8 (Johansson, Landstrom & Lundstrom 1982)",
+                                "held out", "V"),
+        "best_frequency_RAII": R(150.0, 400.0, "docs/references.md row 8: FA-II best at 200-300 Hz", "held out", "V"),
+        "tuned_SAI": R(0.89, 0.97, tuned + ": 93 +- 4%", "fitted", "R"),
+        "tuned_RAI": R(0.79, 0.87, tuned + ": 83 +- 4%", "fitted", "R"),
+        "dsi_mean_SAI": R(0.20, 0.26, tuned + ": 0.23 +- 0.03", "fitted", "V"),
+        "dsi_sd_SAI": R(0.13, 0.23, tuned + ": SD 0.18 +- 0.05", "fitted", "V"),
+        "dsi_mean_RAI": R(0.21, 0.27, tuned + ": 0.24 +- 0.03", "fitted", "V"),
+        "dsi_sd_RAI": R(0.13, 0.23, tuned + ": SD 0.18 +- 0.05", "fitted", "V"),
+        "tuned_SAII": R(0.5, 1.0, "docs/references.md rows 9, 12: most SA-II direction tuned (broad range, R)",
+                        "held out", "R"),
+        "tuned_recorded": R(0.83, 0.89, tuned + ": 86% pooled over SA-I, SA-II and FA-I; not independent of the "
+                            "fitted SA-I and FA-I rows", "held out", "R"),
+        "latency_vs_count": R(0.0, 1.5, "docs/references.md row 13 (Saal et al. 2009): first spike ~ counts",
+                              "held out", "V"),
+        "jitter_RAI": R(0.5, 10.0, "docs/references.md row 14: jitter of a few ms (R: a broad range)", "held out", "R"),
+        "continuity": R(0.0, 0.2, "docs/model.md (the smooth reading): F_A continuous for continuous forces (the step "
+                        "shrinks with the sample interval: 0.1 when continuous, 1 at a jump)", "held out", "V"),
+    }
+
+
+#: Reference ranges of ``ddmm physiology``, by property name.
+
+
+def __getattr__(name):
+    """``PHYSIOLOGY_REFERENCE`` is built on first use: it needs `ddmm.population.analysis.physiology`, which
+    registering the command line must not import."""
+    if name == "PHYSIOLOGY_REFERENCE":
+        value = globals()["PHYSIOLOGY_REFERENCE"] = _physiology_reference()
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,0 +1,19 @@
+"""Analysis of simulated spikes, as a physiologist or a decoder would read them.
+
+- `tuning`: direction tuning as microneurography measures it;
+- `decode`: shear-direction decoders (population vector, maximum likelihood,
+  first-spike latency);
+- `array_decode`: torque and slip from force fields;
+- `physiology`: the physiology scorecard against human recordings.
+"""
+
+from ddmm.models._lazy import lazy_exports
+
+_WHERE = {
+    "tuning": ("direction_tuning", "tuning_scenes", "tuning_summary"),
+    "decode": ("DECODERS", "FirstSpikeLatency", "MaximumLikelihood", "PopulationVector", "angular_error",
+               "select_afferents", "window_responses"),
+    "array_decode": ("CentroidClassifier", "SlipDetector", "evaluate_slip", "onset_counts", "stage_onset"),
+    "physiology": ("PROPERTIES", "score_physiology", "summarise_scorecard"),
+}
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

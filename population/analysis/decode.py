@@ -1,0 +1,274 @@
+"""Decoding shear direction from population spikes.
+
+Three decoders share a scikit-learn-like API on simulation datasets:
+``fit(dataset)`` learns from every (condition, trial) whose scene has a
+nominal shear direction (``has_theta_r == 1``), ``predict(dataset)``
+returns the decoded direction (deg) per (condition, trial).  Responses are
+read in a decision window of ``window_s`` seconds after contact onset (the
+first sample with F_Z above `ddmm.models.metrics.CONTACT_THRESHOLD`).
+
+* `PopulationVector`: baseline-subtracted spike counts weight unit vectors
+  at each afferent's tuning angle theta_T; bipolar afferents are axial (their
+  votes live on the doubled-angle circle and are folded onto the unipolar
+  estimate); untuned afferents carry no direction and are left out.
+* `MaximumLikelihood`: each afferent's count is Poisson with a log-rate
+  that is a second-order Fourier series of direction, fitted on training
+  trials (penalised maximum likelihood, L-BFGS); a test trial is decoded as
+  the direction maximising the population log-likelihood.
+* `FirstSpikeLatency`: each afferent's first-spike latency, clipped at the
+  window's end (a silent afferent reads "no earlier than the window"), is a
+  second-order Fourier series of direction fitted by least squares; only
+  afferents whose latency is significantly tuned (F-test, p < 0.01) are
+  used, and a test trial is decoded by weighted least-squares matching of
+  the latencies (Johansson & Birznieks 2004: ensembles signal direction by
+  their first spikes).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from scipy import stats
+from scipy.optimize import minimize
+
+from ddmm.models.metrics import CONTACT_THRESHOLD
+
+__all__ = ["angular_error", "contact_onset", "window_responses", "select_afferents", "population_vector",
+           "PopulationVector",
+           "MaximumLikelihood", "FirstSpikeLatency", "DECODERS"]
+
+_GRID = np.deg2rad(np.arange(0.0, 360.0, 0.5))
+
+
+def angular_error(a_deg, b_deg) -> np.ndarray:
+    """Absolute angular difference in degrees, wrapped to [0, 180].
+
+    Examples
+    --------
+    >>> angular_error([350.0, 10.0], [10.0, 200.0]).tolist()
+    [20.0, 170.0]
+    """
+    d = np.mod(np.asarray(a_deg, float) - np.asarray(b_deg, float), 360.0)
+    return np.minimum(d, 360.0 - d)
+
+
+def contact_onset(ds: xr.Dataset) -> np.ndarray:
+    """Contact onset per condition in seconds (first F_Z sample above the contact threshold)."""
+    if "fz" not in ds:
+        raise ValueError("decoding needs the scene forces; simulate with record including 'forces'")
+    above = ds.fz.values > CONTACT_THRESHOLD
+    if not above.any(axis=1).all():
+        bad = str(ds.condition.values[np.flatnonzero(~above.any(axis=1))[0]])
+        raise ValueError(f"condition {bad!r} never makes contact (F_Z never exceeds {CONTACT_THRESHOLD} N)")
+    return ds.time.values[above.argmax(axis=1)]
+
+
+def window_responses(ds: xr.Dataset, window_s: float):
+    """Counts and first-spike latencies in [onset, onset + window) per (condition, trial, afferent).
+
+    Returns
+    -------
+    counts : ndarray of int, shape (condition, trial, afferent)
+    latency : ndarray of float, same shape; ``window_s`` where no spike came (censored), in s
+    """
+    if not (isinstance(window_s, (int, float)) and window_s > 0):
+        raise ValueError(f"window_s must be > 0 s, got {window_s!r}")
+    if "spike_time" not in ds:
+        raise ValueError("decoding needs spike events; simulate with record including 'spikes'")
+    onset = contact_onset(ds)
+    too_long = onset + window_s > ds.duration.values + 1e-12
+    if too_long.any():
+        c = int(np.flatnonzero(too_long)[0])
+        raise ValueError(f"window of {window_s * 1e3:g} ms after contact onset ({onset[c] * 1e3:g} ms) is longer "
+                         f"than condition {str(ds.condition.values[c])!r} ({ds.duration.values[c] * 1e3:g} ms)")
+    cond, trial, aff = (ds[v].values for v in ("spike_condition", "spike_trial", "spike_afferent"))
+    rel = ds.spike_time.values - onset[cond]
+    keep = (rel >= 0) & (rel < window_s)
+    shape = (ds.sizes["condition"], ds.sizes["trial"], ds.sizes["afferent"])
+    counts = np.zeros(shape, np.int64)
+    np.add.at(counts, (cond[keep], trial[keep], aff[keep]), 1)
+    latency = np.full(shape, float(window_s))
+    np.minimum.at(latency, (cond[keep], trial[keep], aff[keep]), rel[keep])
+    return counts, latency
+
+
+def select_afferents(ds: xr.Dataset, positions) -> xr.Dataset:
+    """The dataset restricted to afferents at ``positions``, spike events remapped."""
+    positions = np.asarray(positions, dtype=np.int64)
+    out = ds.isel(afferent=positions)
+    if "spike_afferent" in ds:
+        remap = np.full(ds.sizes["afferent"], -1, np.int64)
+        remap[positions] = np.arange(positions.size)
+        new = remap[ds.spike_afferent.values]
+        keep = np.flatnonzero(new >= 0)
+        out = out.isel(spike=keep)
+        out["spike_afferent"] = ("spike", new[keep].astype(np.int32), ds.spike_afferent.attrs)
+    return out
+
+
+def _labelled(ds: xr.Dataset, features, need: int, distinct: int, who: str):
+    """Observations with a known direction: (features of shape (obs, afferent, ...), angles deg)."""
+    has = ds.has_theta_r.values == 1
+    n_obs = int(has.sum()) * ds.sizes["trial"]
+    n_dir = np.unique(np.round(ds.theta_r.values[has], 6)).size
+    if n_obs < need or n_dir < distinct:
+        raise ValueError(f"{who} needs at least {need} trials with a shear direction, spanning at least "
+                         f"{distinct} distinct directions; got {n_obs} trials over {n_dir} directions")
+    angles = np.repeat(ds.theta_r.values[has], ds.sizes["trial"])
+    return [f[has].reshape(n_obs, *f.shape[2:]) for f in features], angles
+
+
+def _harmonics(theta_rad) -> np.ndarray:
+    t = np.atleast_1d(theta_rad)
+    return np.stack([np.ones_like(t), np.cos(t), np.sin(t), np.cos(2 * t), np.sin(2 * t)], axis=-1)
+
+
+class _Decoder:
+    """Shared plumbing: windows, population checks, output shape."""
+
+    name = "decoder"
+    min_trials, min_directions = 1, 1
+
+    def __init__(self, window_s: float = 0.125):
+        if not (isinstance(window_s, (int, float)) and window_s > 0):
+            raise ValueError(f"window_s must be > 0 s, got {window_s!r}")
+        self.window_s = float(window_s)
+        self.afferent_ids_ = None
+
+    def _features(self, ds):
+        return window_responses(ds, self.window_s)
+
+    def fit(self, ds: xr.Dataset) -> "_Decoder":
+        """Learn from the trials of ``ds`` that have a nominal shear direction."""
+        features, angles = _labelled(ds, self._features(ds), self.min_trials, self.min_directions, self.name)
+        self.afferent_ids_ = ds.afferent.values.copy()
+        self._fit(ds, *features, np.deg2rad(angles))
+        return self
+
+    def predict(self, ds: xr.Dataset) -> xr.DataArray:
+        """Decoded direction (deg, [0, 360)) per (condition, trial)."""
+        if self.afferent_ids_ is None:
+            raise ValueError(f"{self.name} is not fitted; call fit(dataset) first")
+        ids = ds.afferent.values
+        if ids.shape != self.afferent_ids_.shape or not np.array_equal(ids, self.afferent_ids_):
+            raise ValueError(f"{self.name} was fitted on {self.afferent_ids_.size} afferents but predict got "
+                             f"{ids.size} with different ids; fit and predict need the same population")
+        features = self._features(ds)
+        n_c, n_t = ds.sizes["condition"], ds.sizes["trial"]
+        flat = [f.reshape(n_c * n_t, *f.shape[2:]) for f in features]
+        theta = np.mod(np.rad2deg(self._predict(*flat)), 360.0).reshape(n_c, n_t)
+        return xr.DataArray(theta, dims=("condition", "trial"), coords={"condition": ds.condition, "trial": ds.trial},
+                            attrs={"units": "deg", "decoder": self.name, "window_s": self.window_s})
+
+
+def population_vector(responses, theta_t_deg, nap, baseline, scale) -> np.ndarray:
+    """Population-vector direction (radians) of each row of ``responses`` (obs, afferent).
+
+    Weights ``(r - baseline) / scale`` multiply unit vectors at theta_T for
+    unipolar afferents; bipolar afferents vote on the doubled-angle circle and
+    that axis is folded onto the unipolar estimate; untuned ones are ignored.
+    """
+    theta = np.deg2rad(np.asarray(theta_t_deg, float))
+    nap = np.asarray(nap, dtype=object)
+    w = (np.asarray(responses, float) - baseline) / scale
+    uni = w @ (np.exp(1j * theta) * np.isin(nap, ("selective", "broad")))
+    axial = w @ (np.exp(2j * theta) * (nap == "bipolar"))
+    half = np.angle(axial) / 2.0  # axis, 180-deg ambiguous
+    pick = np.where(np.cos(half - np.angle(uni)) >= 0, half, half + np.pi)
+    return np.angle(uni + np.abs(axial) * np.exp(1j * pick))
+
+
+class PopulationVector(_Decoder):
+    """Rate-weighted unit vectors at theta_T; bipolar afferents axial (see `population_vector`)."""
+
+    name = "population_vector"
+
+    def _fit(self, ds, counts, latency, angles):
+        self.baseline_ = counts.mean(axis=0)
+        self.scale_ = counts.std(axis=0) + 1.0  # equalises afferents with different rates
+        self.theta_t_, self.nap_ = ds.theta_t.values, ds.nap.values
+
+    def _predict(self, counts, latency):
+        return population_vector(counts, self.theta_t_, self.nap_, self.baseline_, self.scale_)
+
+
+class MaximumLikelihood(_Decoder):
+    """Poisson tuning curves (log-rate: 2nd-order Fourier series), decoded by maximum likelihood."""
+
+    name = "maximum_likelihood"
+    min_trials, min_directions = 10, 5
+    ridge = 1e-2  # penalty on the non-constant coefficients, keeps silent afferents finite
+
+    def _fit(self, ds, counts, latency, angles):
+        x = _harmonics(angles)  # (obs, 5)
+        y = counts.astype(float)  # (obs, afferent)
+        n_aff = y.shape[1]
+        b0 = np.zeros((5, n_aff))
+        b0[0] = np.log(y.mean(axis=0) + 0.1)
+        penalty = np.r_[0.0, np.full(4, self.ridge)][:, None]
+
+        def loss(flat):
+            b = flat.reshape(5, n_aff)
+            eta = np.clip(x @ b, -30.0, 30.0)
+            mu = np.exp(eta)
+            value = np.sum(mu - y * eta) + 0.5 * np.sum(penalty * b * b) * len(y)
+            grad = x.T @ (mu - y) + penalty * b * len(y)
+            return value, grad.ravel()
+
+        res = minimize(loss, b0.ravel(), jac=True, method="L-BFGS-B", options={"maxiter": 500})
+        self.coef_ = res.x.reshape(5, n_aff)
+        log_rate = np.clip(_harmonics(_GRID) @ self.coef_, -30.0, 30.0)  # (grid, afferent)
+        self._grid_log_rate, self._grid_rate = log_rate, np.exp(log_rate).sum(axis=1)
+
+    def _predict(self, counts, latency):
+        ll = counts @ self._grid_log_rate.T - self._grid_rate  # (obs, grid)
+        return _refine_on_grid(ll)
+
+
+class FirstSpikeLatency(_Decoder):
+    """First-spike latencies (clipped at the window's end) matched to fitted latency curves."""
+
+    name = "first_spike_latency"
+    min_trials, min_directions = 10, 5
+    alpha = 0.01  # significance of latency tuning for an afferent to be used
+
+    def _fit(self, ds, counts, latency, angles):
+        # A silent afferent reads as "latency >= window": the clipped latency
+        # is a complete, bounded feature, so every trial enters the fit.
+        x = _harmonics(angles)  # (obs, 5)
+        coef, *_ = np.linalg.lstsq(x, latency, rcond=None)  # (5, afferent)
+        n = latency.shape[0]
+        ss_full = ((latency - x @ coef) ** 2).sum(axis=0)
+        ss_flat = ((latency - latency.mean(axis=0)) ** 2).sum(axis=0)
+        dof = max(n - 5, 1)
+        self.sigma_ = np.sqrt(ss_full / dof) + 1e-4  # s; floor for perfectly regular units
+        # Keep afferents whose latency depends on direction (F-test of the
+        # Fourier fit against a constant): flat, noisy curves of hundreds of
+        # untuned afferents would otherwise swamp the score with overfit wiggles.
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f_stat = ((ss_flat - ss_full) / 4.0) / (ss_full / dof)
+        p = np.where(ss_full > 0, stats.f.sf(f_stat, 4, dof), np.where(ss_flat > 0, 0.0, 1.0))
+        self.usable_ = p < self.alpha
+        if not self.usable_.any():  # no information: decode from the best there is (about chance level)
+            self.usable_ = p <= p.min()
+        self._grid_latency = _harmonics(_GRID) @ coef  # (grid, afferent)
+
+    def _predict(self, counts, latency):
+        pred = self._grid_latency[None, :, self.usable_]  # (1, grid, used)
+        miss = (latency[:, None, self.usable_] - pred) / self.sigma_[self.usable_]
+        return _refine_on_grid(-0.5 * np.sum(miss**2, axis=2))
+
+
+def _refine_on_grid(score: np.ndarray) -> np.ndarray:
+    """Argmax on the circular grid, refined by a parabola through the neighbours (radians)."""
+    i = score.argmax(axis=1)
+    n = _GRID.size
+    rows = np.arange(score.shape[0])
+    left, mid, right = score[rows, (i - 1) % n], score[rows, i], score[rows, (i + 1) % n]
+    denom = left - 2 * mid + right
+    shift = np.where(denom < 0, 0.5 * (left - right) / np.where(denom < 0, denom, -1.0), 0.0)
+    return _GRID[i] + np.clip(shift, -0.5, 0.5) * (_GRID[1] - _GRID[0])
+
+
+#: Decoder classes by name (the JSON keys of ``ddmm decode``).
+DECODERS = {cls.name: cls for cls in (PopulationVector, MaximumLikelihood, FirstSpikeLatency)}

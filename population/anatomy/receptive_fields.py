@@ -1,0 +1,161 @@
+"""Receptive fields and local drive: how strongly each force site drives each afferent.
+
+**Weights.**  An afferent inside a contact (or site) footprint gets weight
+1.  Outside, the weight falls as a Gaussian of the distance beyond the
+footprint's edge, with a width per type, and is exactly 0 beyond
+``RF_SUPPORT`` widths (so such afferents provably stay at rest and are
+skipped).  The widths follow docs/references.md row 17 (Johansson & Vallbo
+1980): a point probe drives an afferent at half weight or more over an area
+equal to the type's median receptive field, 11.0 mm^2 (SA-I), 12.6 mm^2
+(FA-I), about 5x SA-I's for SA-II and 10x for FA-II.
+
+**Local force of a multi-site scene** (`local_mixing`).  The DDMM's force is
+the force on a fingertip-sized contact, so a site's force counts as the
+traction over its footprint (area a_s) times the reference area
+``REFERENCE_AREA_MM2`` (A_ref).  Afferent i, with weights w_is summing to
+S_i over the sites that reach it, receives
+
+    F_i = sum_s (w_is / S_i) (A_ref / a_s) F_s      (three axes)
+
+the weighted mean of the sites' tractions times A_ref, and its drive is
+scaled by the coverage ``min(S_i, 1)`` (the one-site scene's weight).  Its
+own local shear direction then drives its AF.  A site whose footprint is
+A_ref, alone over an afferent, gives F_i = F_s exactly: the one-site scene.
+Site forces are in the population's frame (the hand frame of
+`ddmm.population.anatomy.hand_map`), so the AF compares them with each afferent's tuning
+angle turned into that frame, ``theta_T + frame_deg`` (`frame_theta`); a
+one-site scene's force acts in every afferent's own digit frame.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ddmm.models.currents import AFFERENT_TYPES
+from ddmm.population.stimuli.scenes import Contact
+
+__all__ = ["RF_AREA_MM2", "RF_SIGMA_MM", "RF_SUPPORT", "REFERENCE_AREA_MM2", "receptive_field_weight",
+           "site_weights", "local_mixing", "site_coverage", "frame_theta"]
+
+#: Median receptive-field area per type in mm^2 (docs/references.md row 17: SA-I, FA-I read (V); SA-II about
+#: 5x and FA-II about 10x larger, read in a secondary source (V2)).
+RF_AREA_MM2 = {"SAI": 11.0, "RAI": 12.6, "SAII": 5 * 11.0, "RAII": 10 * 12.6}
+#: Gaussian fall-off width per type (mm): a point probe gets weight >= 1/2 within sigma * sqrt(2 ln 2),
+#: a disc whose area is the type's median field.
+RF_SIGMA_MM = {kind: float(np.sqrt(area / np.pi) / np.sqrt(2.0 * np.log(2.0))) for kind, area in RF_AREA_MM2.items()}
+#: The contact area the model's forces refer to, mm^2: a fingertip pad under a flat surface at 2-4 N,
+#: a disc of 6 mm radius (recalled, not read in a stored source: R).
+REFERENCE_AREA_MM2 = float(np.pi * 6.0 ** 2)
+#: Weights are exactly 0 beyond this many widths outside the contact.
+RF_SUPPORT = 3.0
+
+
+def receptive_field_weight(x_mm, y_mm, afferent_type, contact) -> np.ndarray:
+    """Drive weight in [0, 1] of afferents at (x, y) for a contact disc.
+
+    Parameters
+    ----------
+    x_mm, y_mm : array_like
+        Afferent positions in mm.
+    afferent_type : array_like of str
+        Type of each afferent (selects the width).
+    contact : ddmm.population.stimuli.scenes.Contact
+        Centre and radius of the contact, in mm.
+
+    Examples
+    --------
+    >>> from ddmm.population.stimuli.scenes import Contact
+    >>> w = receptive_field_weight([0.0, 1.0 + RF_SIGMA_MM["SAI"], 9.0], [0.0, 0.0, 0.0], ["SAI"] * 3,
+    ...                            Contact(0.0, 0.0, 1.0))
+    >>> w.round(3).tolist()
+    [1.0, 0.607, 0.0]
+    """
+    x = np.asarray(x_mm, dtype=float)
+    y = np.asarray(y_mm, dtype=float)
+    types = np.asarray(afferent_type, dtype=object)
+    sigma = np.empty(x.shape)
+    for kind in AFFERENT_TYPES:
+        sigma[types == kind] = RF_SIGMA_MM[kind]
+    excess = np.maximum(np.hypot(x - contact.x_mm, y - contact.y_mm) - contact.radius_mm, 0.0)
+    weight = np.exp(-0.5 * (excess / sigma) ** 2)
+    weight[excess > RF_SUPPORT * sigma] = 0.0
+    return weight
+
+
+def site_weights(x_mm, y_mm, afferent_type, sites) -> np.ndarray:
+    """Receptive-field weight of every afferent for every site, shape (n_afferents, n_sites).
+
+    Each site's footprint is a disc (``sites.radius_mm``); see
+    `receptive_field_weight`.
+
+    Examples
+    --------
+    >>> from ddmm.population.stimuli.scenes import Sites
+    >>> w = site_weights([0.0, 9.0], [0.0, 0.0], ["SAI", "SAI"], Sites([0.0, 9.0], [0.0, 0.0], 1.0))
+    >>> w.round(3).tolist()
+    [[1.0, 0.0], [0.0, 1.0]]
+    """
+    out = np.empty((np.size(x_mm), len(sites)))
+    for s in range(len(sites)):
+        disc = Contact(float(sites.x_mm[s]), float(sites.y_mm[s]), float(sites.radius_mm[s]))
+        out[:, s] = receptive_field_weight(x_mm, y_mm, afferent_type, disc)
+    return out
+
+
+def local_mixing(x_mm, y_mm, afferent_type, sites):
+    """Sparse coefficients of each afferent's local force and its coverage (module docstring).
+
+    Returns
+    -------
+    indptr : ndarray of int64, shape (n_afferents + 1,)
+    indices : ndarray of int64
+        Sites reaching afferent i: ``indices[indptr[i]:indptr[i + 1]]``.
+    coeff : ndarray of float
+        Their coefficients ``(w_is / S_i) (A_ref / a_s)`` (dimensionless).
+    coverage : ndarray of float, shape (n_afferents,)
+        ``min(S_i, 1)``, the drive's scale; 0 for afferents no site reaches.
+
+    Examples
+    --------
+    >>> from ddmm.population.stimuli.scenes import Sites
+    >>> r = float(np.sqrt(REFERENCE_AREA_MM2 / np.pi))
+    >>> indptr, indices, coeff, cover = local_mixing([0.0, 40.0], [0.0, 0.0], ["SAI"] * 2, Sites([0.0], [0.0], r))
+    >>> indptr.tolist(), coeff.tolist(), cover.tolist()
+    ([0, 1, 1], [1.0], [1.0, 0.0])
+    """
+    w = site_weights(x_mm, y_mm, afferent_type, sites)
+    total = w.sum(axis=1)
+    rows, cols = np.nonzero(w)
+    factor = REFERENCE_AREA_MM2 / sites.area_mm2
+    coeff = (w[rows, cols] / total[rows]) * factor[cols]
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=w.shape[0]))]).astype(np.int64)
+    return indptr, cols.astype(np.int64), coeff, np.minimum(total, 1.0)
+
+
+def site_coverage(population, sites) -> np.ndarray:
+    """Each afferent's coverage ``min(S_i, 1)`` by a multi-site scene's sites (its drive scale).
+
+    Raises
+    ------
+    ValueError
+        If a site reaches no afferent of the population (it lies outside
+        every region the population covers), naming the site.
+    """
+    w = site_weights(population.x_mm, population.y_mm, population.afferent_type, sites)
+    dead = np.flatnonzero(~np.any(w > 0.0, axis=0))
+    if dead.size:
+        s = dead[0]
+        raise ValueError(f"site {sites.site_id[s]!r} at ({sites.x_mm[s]:g}, {sites.y_mm[s]:g}) mm reaches no "
+                         f"afferent of population {population.name!r}: it lies outside every region the "
+                         "population covers")
+    return np.minimum(w.sum(axis=1), 1.0)
+
+
+def frame_theta(population) -> np.ndarray:
+    """Tuning angles (deg) in the population's frame: theta_T (in the afferent's digit frame) + ``frame_deg``.
+
+    Multi-site forces are given in the population's frame; a one-site
+    scene's force acts in every afferent's own digit frame, so it uses
+    theta_T alone.
+    """
+    return population.theta_t + population.frame_deg

@@ -1,0 +1,19 @@
+"""Runtime: how a run is carried out, beside the simulation core.
+
+- `plan`: what a run computes and what it skips (`make_plan`);
+- `noise`: counter-based current noise, keyed so chunking never changes it;
+- `stream`: the streaming encoder (`Encoder`), live force in, spikes out;
+- `step_choice`: the (dt, method) that meets an accuracy tolerance;
+- `distributed`: a run's afferent blocks as Dask tasks.
+"""
+
+from ddmm.models._lazy import lazy_exports
+
+_WHERE = {
+    "plan": ("RECORD_CHOICES", "ConditionPlan", "Plan", "make_plan"),
+    "noise": ("noise_key", "root_seed"),
+    "stream": ("Encoder", "StreamSpikes"),
+    "step_choice": ("choose_setting", "load_table"),
+    "distributed": ("dask_client",),
+}
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

@@ -1,0 +1,195 @@
+"""A streaming encoder: live fingertip force in, spikes out, with bounded latency.
+
+`Encoder` keeps the whole pipeline's state between calls: the filters and
+every neuron's (v, u).  Each chunk runs through `ddmm.models.fused.FusedPipeline`,
+the very plan `simulate` runs offline, and the noise of sample n of
+afferent a is a pure function of (seed, condition 0, trial 0, a, n)
+(`ddmm.population.runtime.noise`), drawn on demand inside the kernel.  So the
+concatenated spikes of *any* chunking equal the offline run of the whole
+signal with the same seed, bit for bit, with no noise drawn ahead, no
+background thread and no queue.  An engine may integrate a push in
+parallel (`Engine.stream_parts`): the direct engine, from
+``DirectEngine.parallel_min_afferents`` afferents, integrates its neurons on every core (``DDMM_NUM_THREADS``) in one
+numba parallel region; neurons are independent, so no spike changes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ddmm.models._validation import as_finite_array, check_choice, check_positive
+from ddmm.models.attenuation import NO_SHEAR_READINGS
+from ddmm.models.currents import check_fs
+from ddmm.models.engines import METHODS, get_engine, substeps_for
+from ddmm.population.anatomy.receptive_fields import receptive_field_weight, site_coverage
+from ddmm.population.runtime.noise import noise_key, root_seed
+from ddmm.population.sampling import Population
+from ddmm.population.simulation import _grouped, block_pipeline
+from ddmm.population.stimuli.scenes import Contact, Sites
+
+__all__ = ["StreamSpikes", "Encoder"]
+
+
+@dataclass(frozen=True)
+class StreamSpikes:
+    """Spikes of one pushed chunk.
+
+    Attributes
+    ----------
+    afferent : ndarray of int64
+        Position of the spiking afferent in the encoder's population.
+    time : ndarray of float
+        Spike time in seconds since the first sample (``step * dt``).
+    """
+
+    afferent: np.ndarray
+    time: np.ndarray
+
+
+class Encoder:
+    """Turn streamed force samples into spikes, chunk by chunk.
+
+    Parameters
+    ----------
+    population : Population
+        The afferents.
+    fs : float
+        Sample rate of the force stream in Hz.
+    dt : float
+        Integration step in seconds (must divide ``1/fs``).
+    engine : {"direct", "brian2"}
+        Simulation engine (direct by default: it is the low-latency one).
+    method : str
+        Integration scheme.
+    seed : int, Generator or None
+        Root of the noise streams (as in `simulate`).
+    no_shear : {"pass", "block", "smooth"}
+        Reading of eq. 17 (default "smooth", as `simulate`).
+    contact : Contact, optional
+        Fixed contact geometry, for receptive-field weighting.
+    sites : Sites, optional
+        The force sites of a sensor array or multi-digit hand: chunks are
+        then (n, n_sites, 3), and each afferent feels its own local force
+        (`ddmm.population.anatomy.receptive_fields`), as `simulate` does for `Scene.from_sites`.
+
+    Notes
+    -----
+    From ``DirectEngine.parallel_min_afferents`` afferents, the direct engine's pushes run
+    on ``DDMM_NUM_THREADS`` numba threads (default: every core), read when
+    the encoder is made; ``DDMM_NUM_THREADS=1`` keeps a push on one core.
+
+    Examples
+    --------
+    >>> from ddmm.population import make_population
+    >>> enc = Encoder(make_population(["SAI"]), fs=1000.0, engine="direct", seed=1)
+    >>> out = enc.push(np.column_stack([np.zeros(300), np.zeros(300), np.full(300, 4.0)]))
+    >>> bool(out.afferent.size > 0)
+    True
+    """
+
+    def __init__(self, population, fs: float, *, dt: float = 1e-4, engine: str = "direct", method: str = "euler",
+                 seed=None, no_shear: str = "smooth", contact: Contact | None = None, sites: Sites | None = None):
+        if not isinstance(population, Population):
+            raise TypeError(f"population must be a Population, got {type(population).__name__}")
+        self.fs = check_positive(fs, "fs", "Hz")
+        self.substeps = substeps_for(self.fs, dt)
+        self.dt, self._engine = float(dt), get_engine(engine)
+        self.engine = self._engine.name
+        self.method = check_choice(method, "method", METHODS)
+        self.no_shear = check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
+        if contact is not None and not isinstance(contact, Contact):
+            raise TypeError(f"contact must be a Contact or None, got {type(contact).__name__}")
+        if sites is not None and (not isinstance(sites, Sites) or contact is not None):
+            raise TypeError("sites must be a Sites (and then no contact is given), got "
+                            f"{type(sites).__name__} with contact={contact!r}")
+        self.seed, self.contact = root_seed(seed), contact
+        self.sites = sites
+        check_fs(self.fs, population.current, tuple(np.unique(population.afferent_type)))
+        idx = np.arange(len(population))
+        self._order = _grouped(population, idx, idx)  # contiguous (type, NAP) groups, as offline
+        self._pop = population.select(self._order)
+        self._precompute()
+        self._engine.prepare()
+        self.reset()
+
+    def _precompute(self) -> None:
+        """The fused pipeline (the one `simulate` builds for these afferents, with its site mixing)."""
+        pop = self._pop
+        scale = pop.gain
+        if self.contact is not None:
+            scale = pop.gain * receptive_field_weight(pop.x_mm, pop.y_mm, pop.afferent_type, self.contact)
+        elif self.sites is not None:
+            scale = pop.gain * site_coverage(pop, self.sites)
+        self._pipeline = block_pipeline(pop, self.fs, self.sites, scale, self.no_shear)
+        # Read once: a push is latency-bound, and the thread count is fixed for the encoder's life.
+        self._parts = self._engine.stream_parts(len(pop))
+        noisy = np.any(pop.noise_sigma > 0) or np.any(pop.noise_cv > 0)
+        self._key = noise_key(self.seed, 0, 0) if noisy else None
+
+    def reset(self) -> None:
+        """Back to the start: filters at rest on the next sample, neurons at rest, noise from sample 0."""
+        self._state, self._neuron, self._samples, self._last_time = self._pipeline.new_state(), None, 0, None
+
+    def wait_ready(self) -> None:
+        """Nothing to prepare: noise is drawn on demand (kept so real-time loops written for it still run)."""
+
+    @property
+    def n_samples(self) -> int:
+        """Samples consumed since the start (or the last reset)."""
+        return self._samples
+
+    def _validate(self, forces, times):
+        forces = as_finite_array(forces, "forces")
+        if self.sites is not None:
+            if forces.ndim != 3 or forces.shape[1:] != (len(self.sites), 3):
+                raise ValueError(f"forces must have shape (n, n_sites, 3) = (n, {len(self.sites)}, 3) for the "
+                                 f"encoder's sites, got {forces.shape}")
+        elif forces.ndim != 2 or forces.shape[1] != 3:
+            raise ValueError(f"forces must have shape (n, 3) for (fx, fy, fz), got {forces.shape}")
+        if np.any(forces[..., 2] < 0):
+            raise ValueError("forces: the normal force fz must be >= 0 N")
+        if times is not None:
+            times = as_finite_array(times, "times", ndim=1)
+            if times.size != forces.shape[0]:
+                raise ValueError(f"times must have one entry per sample; got {times.size} for {forces.shape[0]}")
+            previous = np.r_[self._last_time if self._last_time is not None else -np.inf, times]
+            if np.any(np.diff(previous) <= 0):
+                raise ValueError("times must increase strictly, continuing from the previous chunk")
+        return forces, times
+
+    def push(self, forces, times=None) -> StreamSpikes:
+        """Consume a chunk of samples; return the spikes that fell inside it.
+
+        Parameters
+        ----------
+        forces : array_like, shape (n, 3)
+            F_X, F_Y, F_Z in newtons, one row per sample at ``fs``.
+        times : array_like, shape (n,), optional
+            Sample times in seconds, checked to increase strictly across
+            chunks (the encoder's clock is the sample count, not these).
+
+        Raises
+        ------
+        ValueError
+            For non-finite values, a negative normal force, a wrong shape or
+            time going backwards; the encoder's state is left untouched.
+        """
+        forces, times = self._validate(forces, times)
+        n = forces.shape[0]
+        if n == 0:
+            return StreamSpikes(np.empty(0, np.int64), np.empty(0))
+        state = self._state.copy()  # committed only if the whole chunk succeeds
+        afferent, step, neuron = self._pipeline.advance(forces, state, self._samples, self._key, self._neuron, dt=self.dt,
+                                                    method=self.method, engine=self._engine, parts=self._parts)
+        step0 = self._samples * self.substeps
+        self._state, self._neuron = state, neuron
+        self._samples += n
+        if times is not None:
+            self._last_time = float(times[-1])
+        afferent, step = self._order[afferent], step + step0
+        if afferent.size > 1:
+            order = np.lexsort((afferent, step))
+            afferent, step = afferent[order], step[order]
+        return StreamSpikes(afferent, step * self.dt)
