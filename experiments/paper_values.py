@@ -82,6 +82,32 @@ def _physiology_reference() -> dict:
     """
     from ddmm.population.analysis.physiology import Reference as R
 
+    return {**_core_reference(R), **_dynamic_reference(R)}
+
+
+def _dynamic_reference(R) -> dict:
+    """Reference ranges of the protocol modules beyond the core battery (phase locking, variability, shear)."""
+    return {**_vibration_reference(R), **_variability_reference(R), **_shear_reference(R)}
+
+
+def _vibration_reference(R) -> dict:
+    """Phase locking to vibration (docs/references.md rows 8, 21)."""
+    return {}
+
+
+def _variability_reference(R) -> dict:
+    """Trial-to-trial variability (docs/references.md rows 14, 23)."""
+    return {}
+
+
+def _shear_reference(R) -> dict:
+    """Tangential force magnitude, SA-II and SA-I dynamics (docs/references.md rows 4-6, 12, 22, 24)."""
+    return {}
+
+
+def _core_reference(R) -> dict:
+    """Reference ranges of the core battery (rest, on-off, rates, force and rate coding, frequency, direction,
+    timing, continuity)."""
     inf = float("inf")
     rest = "docs/references.md row 1 (Vallbo & Johansson 1984; Knibestol 1975); row 2 (foot sole, V)"
     onoff = "docs/references.md rows 3-5 (Westling & Johansson 1987; J Neurosci 3:2652)"

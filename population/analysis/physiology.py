@@ -398,6 +398,28 @@ _RUNNERS = {"rest": _rest, "on_off": _on_off, "rates": _shipped_rates, "force_co
             "frequency": _frequency, "direction": _direction, "timing": _timing, "continuity": _continuity}
 
 
+def _extend(module_name: str) -> None:
+    """Add the properties, protocols and runners of a protocol module of this package.
+
+    A protocol module (``ddmm.population.analysis.<module_name>``) defines
+    ``PROPERTIES`` (name -> `Property`), ``PROTOCOLS`` (names, in the order
+    they run) and ``RUNNERS`` (protocol name -> ``runner(population,
+    context) -> (values, data)``).  It may import this module's helpers
+    (`_run`, `_rates`, `_of`, `_knots`): they are defined before the modules
+    are added, at the end of this module.
+    """
+    from importlib import import_module
+
+    global PROTOCOLS
+    module = import_module(f"ddmm.population.analysis.{module_name}")
+    clash = (set(module.PROPERTIES) & set(PROPERTIES)) | (set(module.PROTOCOLS) & set(PROTOCOLS))
+    if clash:
+        raise RuntimeError(f"{module_name} redefines {sorted(clash)}")
+    PROPERTIES.update(module.PROPERTIES)
+    PROTOCOLS = PROTOCOLS + tuple(module.PROTOCOLS)
+    _RUNNERS.update(module.RUNNERS)
+
+
 def _select(population, properties):
     names = list(PROPERTIES) if properties is None else list(properties)
     for name in names:
@@ -482,3 +504,8 @@ def summarise_scorecard(rows) -> str:
     failing = [row["name"] for row in rows if not row["pass"]]
     line = f"physiology: {sum(r['pass'] for r in rows)}/{len(rows)} properties pass ({parts})"
     return line + (f"; failing: {', '.join(failing)}" if failing else "")
+
+
+# Protocol modules beyond the core battery, each adding its rows (see `_extend`).
+for _name in ():
+    _extend(_name)
