@@ -87,7 +87,14 @@ def _physiology_reference() -> dict:
 
 def _dynamic_reference(R) -> dict:
     """Reference ranges of the protocol modules beyond the core battery (phase locking, variability, shear)."""
-    return {**_vibration_reference(R), **_variability_reference(R), **_shear_reference(R)}
+    return {**_vibration_reference(R), **_variability_reference(R), **_shear_reference(R), **_field_reference(R)}
+
+
+def _field_reference(R) -> dict:
+    """Receptive fields grow with force (docs/references.md row 17; the growth recalled: R)."""
+    source = ("docs/references.md row 17 (Johansson & Vallbo 1980): fields measured at threshold; they grow with "
+              "force (R): every doubling of a point probe's force must widen the field")
+    return {f"field_growth_{kind}": R(1.05, float("inf"), source, "held out", "R") for kind in ("SAI", "RAI", "RAII")}
 
 
 def _vibration_reference(R) -> dict:

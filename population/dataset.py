@@ -68,6 +68,7 @@ def model_attrs(population, config) -> dict:
            for t in ("SAI", "RAI", "RAII")},
         "noise_model": "white Gaussian current, (noise_sigma + noise_cv |I|)/sqrt(h) per sample of h ms",
         "rf_support": RF_SUPPORT,
+        "receptive_field": population.receptive_field,
     }
     for kind, params in NEURON_PARAMS.items():
         for name in ("a", "b", "c", "d"):

@@ -18,6 +18,7 @@ from ddmm.models.attenuation import UNTUNED
 from ddmm.models.currents import AFFERENT_TYPES, CurrentParams, normalize_type
 from ddmm.models.nap import PROFILE_NAMES, k_from_selectivity, validate_k
 from ddmm.population.anatomy import hand_map
+from ddmm.population.anatomy.receptive_fields import check_shape
 from ddmm.population.spec import (
     NAP_CHOICES,
     AngleDistribution,
@@ -68,6 +69,9 @@ class Population:
         Gains and filter of eqs 1-3 shared by the population.
     name : str
         The spec's name.
+    receptive_field : {"gaussian", "tailed"}
+        Shape of the receptive fields' fall-off beyond a contact
+        (`ddmm.population.anatomy.receptive_fields`).
     """
 
     afferent_type: np.ndarray
@@ -84,8 +88,10 @@ class Population:
     frame_deg: np.ndarray = None
     current: CurrentParams = field(default_factory=CurrentParams)
     name: str = "custom"
+    receptive_field: str = "gaussian"
 
     def __post_init__(self):
+        check_shape(self.receptive_field)
         n = len(self.afferent_type)
         if self.region is None:
             object.__setattr__(self, "region", np.full(n, "", dtype=object))
@@ -121,6 +127,7 @@ class Population:
             object.__setattr__(sub, name, arr)
         object.__setattr__(sub, "current", self.current)
         object.__setattr__(sub, "name", self.name)
+        object.__setattr__(sub, "receptive_field", self.receptive_field)
         return sub
 
     def counts(self) -> dict:
@@ -266,12 +273,14 @@ def sample_population(spec, rng=None) -> Population:
     parts = [_sample_type(kind, tspec, *placements[kind], rng) for kind, tspec in spec.types.items()]
     arrays = {name: np.concatenate([p[name] for p in parts]) for name in parts[0]}
     n = len(arrays["theta_t"])
-    return Population(**arrays, afferent_id=np.arange(n, dtype=np.int64), current=spec.current, name=spec.name)
+    return Population(**arrays, afferent_id=np.arange(n, dtype=np.int64), current=spec.current, name=spec.name,
+                      receptive_field=spec.receptive_field)
 
 
 def make_population(afferent_type, theta_t=0.0, nap=UNTUNED, k=3.0, *, gain=1.0, x_mm=0.0, y_mm=0.0,
                     noise_sigma=0.0, noise_cv=0.0, region="", frame_deg=0.0,
-                    current: CurrentParams = CurrentParams(), name="custom") -> Population:
+                    current: CurrentParams = CurrentParams(), name="custom",
+                    receptive_field: str = "gaussian") -> Population:
     """Build a population from explicit per-afferent values (scalars broadcast).
 
     Examples
@@ -290,6 +299,6 @@ def make_population(afferent_type, theta_t=0.0, nap=UNTUNED, k=3.0, *, gain=1.0,
                               ("noise_sigma", noise_sigma), ("noise_cv", noise_cv), ("frame_deg", frame_deg))}
     region = np.array(np.broadcast_to(np.asarray(region, dtype=object), (n,)))
     return Population(afferent_type=types, nap=np.array(nap), k=k, afferent_id=np.arange(n, dtype=np.int64),
-                      region=region, current=current, name=name, **arrays)
+                      region=region, current=current, name=name, receptive_field=receptive_field, **arrays)
 
 

@@ -111,7 +111,7 @@ def block_pipeline(population, fs: float, sites, scale, no_shear: str):
     theta, mixing = pop.theta_t, None
     if sites is not None:
         theta = frame_theta(pop)
-        indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, sites)
+        indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, sites, pop.receptive_field)
         mixing = mixing_matrix(indptr, indices, coeff, len(sites))
     return FusedPipeline(pop.afferent_type, pop.nap, theta, pop.k, scale, pop.noise_cv, pop.noise_sigma, pop.current,
                      fs, no_shear, F_TH, pop.afferent_id, mixing)
@@ -147,11 +147,11 @@ def population_currents(population, scene, *, no_shear: str = "smooth") -> np.nd
     for inspection and for the reference solver; noise is not added.
     """
     check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
-    from ddmm.population.anatomy.receptive_fields import receptive_field_weight, site_coverage
+    from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
 
     weights = None
     if scene.contact is not None:
-        weights = receptive_field_weight(population.x_mm, population.y_mm, population.afferent_type, scene.contact)
+        weights = population_weight(population, scene.contact)
     elif scene.sites is not None:
         weights = site_coverage(population, scene.sites)
     scale = population.gain if weights is None else population.gain * weights

@@ -53,6 +53,7 @@ from ddmm.models.attenuation import UNTUNED
 from ddmm.models.currents import AFFERENT_TYPES, CurrentParams, normalize_type
 from ddmm.models.nap import PROFILE_NAMES
 from ddmm.population.anatomy import hand_map
+from ddmm.population.anatomy.receptive_fields import RF_SHAPES
 
 __all__ = [
     "NAP_CHOICES",
@@ -340,6 +341,10 @@ class PopulationSpec:
     map : MapSpec or None
         When given, afferents are placed region by region of the hand map at
         its densities, and no type gives a count or density.
+    receptive_field : {"gaussian", "tailed"}
+        Fall-off of the receptive fields beyond a contact's edge
+        (`ddmm.population.anatomy.receptive_fields`): the Gaussian with a hard
+        support (default) or the tailed shape whose fields grow with force.
     """
 
     name: str = "custom"
@@ -348,8 +353,11 @@ class PopulationSpec:
     current: CurrentParams = CurrentParams()
     description: str = ""
     map: MapSpec | None = None
+    receptive_field: str = "gaussian"
 
     def __post_init__(self):
+        if self.receptive_field not in RF_SHAPES:
+            _fail("receptive_field", f"{self.receptive_field!r} is not a shape; allowed: {', '.join(RF_SHAPES)}")
         for kind in self.types:
             if kind not in AFFERENT_TYPES:
                 _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)}")

@@ -398,23 +398,36 @@ _RUNNERS = {"rest": _rest, "on_off": _on_off, "rates": _shipped_rates, "force_co
             "frequency": _frequency, "direction": _direction, "timing": _timing, "continuity": _continuity}
 
 
-def _extend(module_name: str) -> None:
-    """Add the properties, protocols and runners of a protocol module of this package.
+#: Protocol modules beyond the core battery, in the order their protocols run.
+EXTENSIONS = ("physiology_fields",)
+_MERGED: set = set()
 
-    A protocol module (``ddmm.population.analysis.<module_name>``) defines
+
+def load_extensions() -> None:
+    """Add the rows of every module of `EXTENSIONS` not added yet (idempotent).
+
+    A protocol module (``ddmm.population.analysis.<name>``) defines
     ``PROPERTIES`` (name -> `Property`), ``PROTOCOLS`` (names, in the order
     they run) and ``RUNNERS`` (protocol name -> ``runner(population,
-    context) -> (values, data)``).  It may import this module's helpers
-    (`_run`, `_rates`, `_of`, `_knots`): they are defined before the modules
-    are added, at the end of this module.
+    context) -> (values, data)``), and may import this module's helpers
+    (`_run`, `_rates`, `_of`, `_knots`).  This module loads them when it is
+    imported; a protocol module imported first (it imports this module
+    before defining its names) calls this function at its end.
     """
     from importlib import import_module
 
+    for name in EXTENSIONS:
+        module = import_module(f"ddmm.population.analysis.{name}")
+        if name not in _MERGED and hasattr(module, "RUNNERS"):  # not while it is still being imported
+            _extend(module)
+            _MERGED.add(name)
+
+
+def _extend(module) -> None:
     global PROTOCOLS
-    module = import_module(f"ddmm.population.analysis.{module_name}")
     clash = (set(module.PROPERTIES) & set(PROPERTIES)) | (set(module.PROTOCOLS) & set(PROTOCOLS))
     if clash:
-        raise RuntimeError(f"{module_name} redefines {sorted(clash)}")
+        raise RuntimeError(f"{module.__name__} redefines {sorted(clash)}")
     PROPERTIES.update(module.PROPERTIES)
     PROTOCOLS = PROTOCOLS + tuple(module.PROTOCOLS)
     _RUNNERS.update(module.RUNNERS)
@@ -506,6 +519,4 @@ def summarise_scorecard(rows) -> str:
     return line + (f"; failing: {', '.join(failing)}" if failing else "")
 
 
-# Protocol modules beyond the core battery, each adding its rows (see `_extend`).
-for _name in ():
-    _extend(_name)
+load_extensions()

@@ -1,13 +1,28 @@
 """Receptive fields and local drive: how strongly each force site drives each afferent.
 
 **Weights.**  An afferent inside a contact (or site) footprint gets weight
-1.  Outside, the weight falls as a Gaussian of the distance beyond the
-footprint's edge, with a width per type, and is exactly 0 beyond
-``RF_SUPPORT`` widths (so such afferents provably stay at rest and are
-skipped).  The widths follow docs/references.md row 17 (Johansson & Vallbo
-1980): a point probe drives an afferent at half weight or more over an area
-equal to the type's median receptive field, 11.0 mm^2 (SA-I), 12.6 mm^2
-(FA-I), about 5x SA-I's for SA-II and 10x for FA-II.
+1.  Outside, the weight falls with the distance e beyond the footprint's
+edge, with a width sigma per type, in one of two shapes (`RF_SHAPES`, the
+population's ``receptive_field``):
+
+* ``"gaussian"``: ``exp(-e^2 / (2 sigma^2))``, exactly 0 beyond
+  ``RF_SUPPORT`` widths.  The weight ends at a cliff (0.011 at 3 sigma):
+  whatever the force, an afferent beyond it never responds, so a
+  receptive field stops growing with force at the cliff.
+* ``"tailed"``: the same Gaussian core out to one width, then an
+  exponential tail with the same value and slope there,
+  ``exp(1/2 - e / sigma)``, exactly 0 where it falls below `RF_TAIL_FLOOR`
+  (7.4 widths).  The half-weight radius is 1.193 widths against the
+  Gaussian's 1.177 (an area 2.7% larger), so the median field areas below
+  still hold; the distance at which a force crosses an afferent's
+  threshold grows with the logarithm of the force, as human fields grow
+  with force (docs/model.md, "What changed in the model, and why").
+
+Afferents at weight 0 provably stay at rest and are skipped.  The widths
+follow docs/references.md row 17 (Johansson & Vallbo 1980): a point probe
+drives an afferent at half weight or more over an area equal to the type's
+median receptive field, 11.0 mm^2 (SA-I), 12.6 mm^2 (FA-I), about 5x SA-I's
+for SA-II and 10x for FA-II.
 
 **Local force of a multi-site scene** (`local_mixing`).  The DDMM's force is
 the force on a fingertip-sized contact, so a site's force counts as the
@@ -34,8 +49,8 @@ import numpy as np
 from ddmm.models.currents import AFFERENT_TYPES
 from ddmm.population.stimuli.scenes import Contact
 
-__all__ = ["RF_AREA_MM2", "RF_SIGMA_MM", "RF_SUPPORT", "REFERENCE_AREA_MM2", "receptive_field_weight",
-           "site_weights", "local_mixing", "site_coverage", "frame_theta"]
+__all__ = ["RF_AREA_MM2", "RF_SIGMA_MM", "RF_SUPPORT", "RF_SHAPES", "RF_TAIL_FLOOR", "REFERENCE_AREA_MM2",
+           "receptive_field_weight", "population_weight", "site_weights", "local_mixing", "site_coverage", "frame_theta"]
 
 #: Median receptive-field area per type in mm^2 (docs/references.md row 17: SA-I, FA-I read (V); SA-II about
 #: 5x and FA-II about 10x larger, read in a secondary source (V2)).
@@ -46,11 +61,40 @@ RF_SIGMA_MM = {kind: float(np.sqrt(area / np.pi) / np.sqrt(2.0 * np.log(2.0))) f
 #: The contact area the model's forces refer to, mm^2: a fingertip pad under a flat surface at 2-4 N,
 #: a disc of 6 mm radius (recalled, not read in a stored source: R).
 REFERENCE_AREA_MM2 = float(np.pi * 6.0 ** 2)
-#: Weights are exactly 0 beyond this many widths outside the contact.
+#: Weights are exactly 0 beyond this many widths outside the contact (the ``"gaussian"`` shape).
 RF_SUPPORT = 3.0
+#: Receptive-field shapes: the Gaussian with a hard support (the package's first form) and the tailed one.
+RF_SHAPES = ("gaussian", "tailed")
+#: The ``"tailed"`` weight is exactly 0 below this value (beyond 0.5 + ln(1000) = 7.4 widths).
+RF_TAIL_FLOOR = 1e-3
 
 
-def receptive_field_weight(x_mm, y_mm, afferent_type, contact) -> np.ndarray:
+def check_shape(shape: str) -> str:
+    """``shape`` if it is one of `RF_SHAPES`, else a ValueError naming ``receptive_field``."""
+    if shape not in RF_SHAPES:
+        raise ValueError(f"receptive_field={shape!r} is not a receptive-field shape; allowed: {', '.join(RF_SHAPES)}")
+    return shape
+
+
+def _falloff(excess, sigma, shape: str) -> np.ndarray:
+    """Weight of afferents ``excess`` mm beyond a footprint's edge (widths ``sigma``, mm)."""
+    z = excess / sigma
+    if shape == "gaussian":
+        weight = np.exp(-0.5 * z * z)
+        weight[z > RF_SUPPORT] = 0.0
+        return weight
+    weight = np.where(z <= 1.0, np.exp(-0.5 * z * z), np.exp(0.5 - z))
+    weight[weight < RF_TAIL_FLOOR] = 0.0
+    return weight
+
+
+def population_weight(population, contact) -> np.ndarray:
+    """`receptive_field_weight` of a population's afferents for a contact, in its ``receptive_field`` shape."""
+    return receptive_field_weight(population.x_mm, population.y_mm, population.afferent_type, contact,
+                                  population.receptive_field)
+
+
+def receptive_field_weight(x_mm, y_mm, afferent_type, contact, shape: str = "gaussian") -> np.ndarray:
     """Drive weight in [0, 1] of afferents at (x, y) for a contact disc.
 
     Parameters
@@ -61,15 +105,19 @@ def receptive_field_weight(x_mm, y_mm, afferent_type, contact) -> np.ndarray:
         Type of each afferent (selects the width).
     contact : ddmm.population.stimuli.scenes.Contact
         Centre and radius of the contact, in mm.
+    shape : {"gaussian", "tailed"}
+        The fall-off beyond the contact's edge (module docstring).
 
     Examples
     --------
     >>> from ddmm.population.stimuli.scenes import Contact
-    >>> w = receptive_field_weight([0.0, 1.0 + RF_SIGMA_MM["SAI"], 9.0], [0.0, 0.0, 0.0], ["SAI"] * 3,
-    ...                            Contact(0.0, 0.0, 1.0))
-    >>> w.round(3).tolist()
+    >>> x = [0.0, 1.0 + RF_SIGMA_MM["SAI"], 9.0]
+    >>> receptive_field_weight(x, [0.0] * 3, ["SAI"] * 3, Contact(0.0, 0.0, 1.0)).round(3).tolist()
     [1.0, 0.607, 0.0]
+    >>> receptive_field_weight(x, [0.0] * 3, ["SAI"] * 3, Contact(0.0, 0.0, 1.0), "tailed").round(3).tolist()
+    [1.0, 0.607, 0.011]
     """
+    check_shape(shape)
     x = np.asarray(x_mm, dtype=float)
     y = np.asarray(y_mm, dtype=float)
     types = np.asarray(afferent_type, dtype=object)
@@ -77,12 +125,10 @@ def receptive_field_weight(x_mm, y_mm, afferent_type, contact) -> np.ndarray:
     for kind in AFFERENT_TYPES:
         sigma[types == kind] = RF_SIGMA_MM[kind]
     excess = np.maximum(np.hypot(x - contact.x_mm, y - contact.y_mm) - contact.radius_mm, 0.0)
-    weight = np.exp(-0.5 * (excess / sigma) ** 2)
-    weight[excess > RF_SUPPORT * sigma] = 0.0
-    return weight
+    return _falloff(excess, sigma, shape)
 
 
-def site_weights(x_mm, y_mm, afferent_type, sites) -> np.ndarray:
+def site_weights(x_mm, y_mm, afferent_type, sites, shape: str = "gaussian") -> np.ndarray:
     """Receptive-field weight of every afferent for every site, shape (n_afferents, n_sites).
 
     Each site's footprint is a disc (``sites.radius_mm``); see
@@ -98,11 +144,11 @@ def site_weights(x_mm, y_mm, afferent_type, sites) -> np.ndarray:
     out = np.empty((np.size(x_mm), len(sites)))
     for s in range(len(sites)):
         disc = Contact(float(sites.x_mm[s]), float(sites.y_mm[s]), float(sites.radius_mm[s]))
-        out[:, s] = receptive_field_weight(x_mm, y_mm, afferent_type, disc)
+        out[:, s] = receptive_field_weight(x_mm, y_mm, afferent_type, disc, shape)
     return out
 
 
-def local_mixing(x_mm, y_mm, afferent_type, sites):
+def local_mixing(x_mm, y_mm, afferent_type, sites, shape: str = "gaussian"):
     """Sparse coefficients of each afferent's local force and its coverage (module docstring).
 
     Returns
@@ -123,7 +169,7 @@ def local_mixing(x_mm, y_mm, afferent_type, sites):
     >>> indptr.tolist(), coeff.tolist(), cover.tolist()
     ([0, 1, 1], [1.0], [1.0, 0.0])
     """
-    w = site_weights(x_mm, y_mm, afferent_type, sites)
+    w = site_weights(x_mm, y_mm, afferent_type, sites, shape)
     total = w.sum(axis=1)
     rows, cols = np.nonzero(w)
     factor = REFERENCE_AREA_MM2 / sites.area_mm2
@@ -141,7 +187,7 @@ def site_coverage(population, sites) -> np.ndarray:
         If a site reaches no afferent of the population (it lies outside
         every region the population covers), naming the site.
     """
-    w = site_weights(population.x_mm, population.y_mm, population.afferent_type, sites)
+    w = site_weights(population.x_mm, population.y_mm, population.afferent_type, sites, population.receptive_field)
     dead = np.flatnonzero(~np.any(w > 0.0, axis=0))
     if dead.size:
         s = dead[0]

@@ -30,7 +30,7 @@ import numpy as np
 from ddmm.models._validation import check_choice
 from ddmm.models.attenuation import F_TH, UNTUNED
 from ddmm.models.currents import AFFERENT_TYPES, normalize_type
-from ddmm.population.anatomy.receptive_fields import receptive_field_weight, site_coverage
+from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
 
 __all__ = ["RECORD_CHOICES", "ConditionPlan", "Plan", "af_threshold", "make_plan"]
 
@@ -198,7 +198,7 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
         weights = site_coverage(pop, scene.sites)[sel]
     elif scene.contact is not None or not enabled:
         weights = (np.ones(n) if scene.contact is None else
-                   receptive_field_weight(pop.x_mm[sel], pop.y_mm[sel], pop.afferent_type[sel], scene.contact))
+                   population_weight(pop, scene.contact)[sel])
     scale = pop.gain[sel] * (1.0 if weights is None else weights)
     noisy = (pop.noise_sigma[sel] > 0) | (pop.noise_cv[sel] > 0)
     if not enabled:

@@ -23,7 +23,7 @@ from ddmm.models._validation import as_finite_array, check_choice, check_positiv
 from ddmm.models.attenuation import NO_SHEAR_READINGS
 from ddmm.models.currents import check_fs
 from ddmm.models.engines import METHODS, get_engine, substeps_for
-from ddmm.population.anatomy.receptive_fields import receptive_field_weight, site_coverage
+from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
 from ddmm.population.runtime.noise import noise_key, root_seed
 from ddmm.population.sampling import Population
 from ddmm.population.simulation import _grouped, block_pipeline
@@ -119,7 +119,7 @@ class Encoder:
         pop = self._pop
         scale = pop.gain
         if self.contact is not None:
-            scale = pop.gain * receptive_field_weight(pop.x_mm, pop.y_mm, pop.afferent_type, self.contact)
+            scale = pop.gain * population_weight(pop, self.contact)
         elif self.sites is not None:
             scale = pop.gain * site_coverage(pop, self.sites)
         self._pipeline = block_pipeline(pop, self.fs, self.sites, scale, self.no_shear)
