@@ -248,10 +248,19 @@ def run_demo(args) -> int:
     for w in caught:
         if not issubclass(w.category, SpikeCapWarning):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    written += _demo_first_look(pop, args, out_dir)
     written += _demo_biology(args, out_dir)
     for path in written:
         print(f"wrote {path}")
     return 0
+
+
+def _demo_first_look(pop, args, out_dir) -> list:
+    """What a physiologist looks at first: a 2 N ramp-and-hold, 8 afferents per type, 10 trials."""
+    from ddmm.experiments.plot_first_look import plot_ramp_and_hold, ramp_and_hold
+
+    ds = ramp_and_hold(pop, seed=args.seed, engine="direct")
+    return [str(save_figure(plot_ramp_and_hold(ds), out_dir / "ramp_and_hold.png"))]
 
 
 def _demo_biology(args, out_dir) -> list:
@@ -272,8 +281,8 @@ def _demo_biology(args, out_dir) -> list:
     frac = summary["tuned_fraction"]
     pooled = frac["recorded"]
     print("\n## Direction tuning (5 force directions x 5 trials, ANOVA per phase, p < 0.05 in either)\n")
-    print(f"tuned: SAI {100 * frac['SAI']:.1f}% (human 93%), RAI {100 * frac['RAI']:.1f}% (83%) [both fitted]; "
-          f"SAII {100 * frac['SAII']:.1f}% [prediction]; over the recorded types SA-I + SA-II + FA-I "
+    print(f"tuned: SA-I {100 * frac['SAI']:.1f}% (human 93%), FA-I {100 * frac['RAI']:.1f}% (83%) [both fitted]; "
+          f"SA-II {100 * frac['SAII']:.1f}% [prediction]; over the recorded types SA-I + SA-II + FA-I "
           f"{100 * pooled:.1f}% (human {100 * HUMAN_TUNED_FRACTION['all']:.0f}%)")
     print("-> Like human recordings, the simulated fingertip is dominated by direction-tuned afferents. The pooled "
           "fraction is the count-weighted mix of the fitted SA-I and FA-I fractions and the predicted SA-II one, "
