@@ -208,6 +208,14 @@ class CurrentParams:
     tau_sai_s, tau_rai_s, tau_raii_s, tau_saii_s : float or None
         Ours: time constant in s of the first-order low-pass on the current
         (after the transducer and the receptor noise); None: none.
+    negative_weight_rai, negative_weight_raii : float
+        Ours: weight (dimensionless, 0 to 1) of the negative half-wave of
+        RA-I's velocity and RA-II's acceleration when they are rectified:
+        ``d = x`` for ``x >= 0`` and ``-w x`` for ``x < 0``.  1.0 is the
+        absolute value of eqs 2-3 (both half-cycles of a vibration excite, so
+        spikes lock to twice its frequency); below 1 the drive keeps the
+        phase of the cycle (one preferred half-cycle), while ``w > 0`` keeps
+        a response to unloading (RA-I's OFF response).
     """
 
     g_sai: float = 5.367  # fitted: CMM SAI SF 47.5 pulses/s (Table III)
@@ -241,6 +249,8 @@ class CurrentParams:
     tau_rai_s: float | None = None
     tau_raii_s: float | None = None
     tau_saii_s: float | None = None
+    negative_weight_rai: float = 1.0
+    negative_weight_raii: float = 1.0
 
     def __post_init__(self):
         for name in ("g_sai", "g_rai", "g_raii", "g_saii", "cutoff_hz", "cutoff_saii_hz", "tau_adapt_sai_s",
@@ -260,6 +270,10 @@ class CurrentParams:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+        for name in ("negative_weight_rai", "negative_weight_raii"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
+                raise ValueError(f"{name} must be a number in [0, 1] (1: the paper's absolute value), got {value!r}")
 
     def _own(self, prefix: str, afferent_type: str, suffix: str = "", default=None):
         """The per-type field ``<prefix>_<type><suffix>`` (e.g. ``i_max_raii``), or ``default`` if it has none."""
@@ -290,7 +304,8 @@ class CurrentParams:
                             self.saturation(afferent_type), self._own("i_max", afferent_type),
                             self._own("bias", afferent_type, default=0.0), self._own("tau", afferent_type, "_s"),
                             self._own("threshold", afferent_type, default=0.0),
-                            self._own("highpass", afferent_type, "_hz"))
+                            self._own("highpass", afferent_type, "_hz"),
+                            float(self._own("negative_weight", afferent_type, default=1.0)))
 
 
 @dataclass(frozen=True)
@@ -320,6 +335,9 @@ class CurrentStage:
         Dead zone of the rectified drive (RA-I's velocity threshold, N/s).
     highpass_hz : float or None
         Cut-off of a 2nd-order high-pass in the filter cascade (RA-II), Hz.
+    negative_weight : float
+        Weight of the derivative's negative half-wave when it is rectified
+        (1.0: the absolute value; dimensionless).
     """
 
     afferent_type: str
@@ -335,6 +353,7 @@ class CurrentStage:
     tau_s: float | None = None
     threshold: float = 0.0
     highpass_hz: float | None = None
+    negative_weight: float = 1.0
 
     @property
     def signed(self) -> bool:
@@ -509,7 +528,7 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
     slow = np.zeros(m)
     # The stage kernel with order 0, unit gain and a signed drive returns exactly deviation + offset.
     y = stage_kernel(_stage_sos(shared, float(fs)), np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow,
-                      float(fs), 0, 0.0, 0.0, 0.0, np.ones(m), _NO_NORMALS, np.ones(m), False, True)
+                      float(fs), 0, 0.0, 0.0, 0.0, 1.0, np.ones(m), _NO_NORMALS, np.ones(m), False, True)
     return y, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2, slow=slow, smooth=state.smooth)
 
 
@@ -589,7 +608,7 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     gain = gain if np.ndim(gain) else np.full(m, gain)
     cv_scale = np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs) if noisy else gain
     drive = stage_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, fs, st.derivative,
-                         float(st.adapt), alpha_adapt, float(st.threshold), gain,
+                         float(st.adapt), alpha_adapt, float(st.threshold), float(st.negative_weight), gain,
                          np.ascontiguousarray(normals) if noisy else _NO_NORMALS, cv_scale, noisy, st.signed)
     current = transduce_inplace(drive, st)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
     if st.tau_s is not None:
