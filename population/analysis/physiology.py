@@ -398,6 +398,9 @@ _RUNNERS = {"rest": _rest, "on_off": _on_off, "rates": _shipped_rates, "force_co
             "frequency": _frequency, "direction": _direction, "timing": _timing, "continuity": _continuity}
 
 
+_EXTENDED = set()  # protocol modules already added
+
+
 def _extend(module_name: str) -> None:
     """Add the properties, protocols and runners of a protocol module of this package.
 
@@ -406,12 +409,17 @@ def _extend(module_name: str) -> None:
     they run) and ``RUNNERS`` (protocol name -> ``runner(population,
     context) -> (values, data)``).  It may import this module's helpers
     (`_run`, `_rates`, `_of`, `_knots`): they are defined before the modules
-    are added, at the end of this module.
+    are added, at the end of this module.  A module imported before this one
+    is mid-import when this module adds it: it is skipped then, so a protocol
+    module also calls `_extend` at its own end (a second call is a no-op).
     """
     from importlib import import_module
 
     global PROTOCOLS
     module = import_module(f"ddmm.population.analysis.{module_name}")
+    if not hasattr(module, "RUNNERS") or module_name in _EXTENDED:
+        return
+    _EXTENDED.add(module_name)
     clash = (set(module.PROPERTIES) & set(PROPERTIES)) | (set(module.PROTOCOLS) & set(PROTOCOLS))
     if clash:
         raise RuntimeError(f"{module_name} redefines {sorted(clash)}")

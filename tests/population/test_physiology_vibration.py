@@ -45,3 +45,16 @@ def test_vector_strength_and_threshold_search():
     both = np.sort(np.r_[spikes, spikes + 0.025])  # both half-cycles: locked to 2f only
     assert vib.vector_strength(both, 20.0) == pytest.approx(0.0, abs=1e-12)
     assert vib.vector_strength(both, 20.0, 2) == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("first", ["ddmm.population.analysis.physiology_vibration",
+                                   "ddmm.population.analysis.physiology"])
+def test_registration_holds_in_either_import_order(first):
+    import subprocess
+    import sys
+
+    code = (f"import importlib; importlib.import_module({first!r}); "
+            "from ddmm.population.analysis import physiology as ph; "
+            "print(ph.PROTOCOLS.count('phase_locking'), 'vs_RAI' in ph.PROPERTIES)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["1", "True"]
