@@ -17,6 +17,10 @@ which the physiological presets switch on (docs/model.md, "What changed in the m
   low-pass before d^2/dt^2 (acceleration: sensitivity grows as f^2 up to the
   cut-off and falls beyond it, a Pacinian band-pass near 150-400 Hz).  A
   scene sampled too slowly to carry RA-II's band is refused (`check_fs`).
+* **Phase-preserving rectification.**  ``negative_weight_rai`` and
+  ``negative_weight_raii`` weight the negative half-wave of the derivative
+  (1.0: the paper's absolute value), so that a vibration excites on one
+  half-cycle and spikes lock to its phase.
 * **Adaptation.**  ``adapt_rai`` makes RA-I adapt to a sustained velocity
   (the rectified velocity minus a low-pass of itself).
 * **Slow adaptation of SA-I.**  ``adapt_sai`` adds ``adapt * (y - slow)``,
