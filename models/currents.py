@@ -277,7 +277,9 @@ class CurrentParams:
         for name in ("negative_weight_rai", "negative_weight_raii"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
-                raise ValueError(f"{name} must be a number in [0, 1] (1: the paper's absolute value), got {value!r}")
+                number = isinstance(value, (int, float)) and not isinstance(value, bool)
+                shown = f"{float(value):g}" if number else repr(value)
+                raise ValueError(f"{name} must be a number in [0, 1] (1: the paper's absolute value), got {shown}")
 
     def _own(self, prefix: str, afferent_type: str, suffix: str = "", default=None):
         """The per-type field ``<prefix>_<type><suffix>`` (e.g. ``i_max_raii``), or ``default`` if it has none."""
