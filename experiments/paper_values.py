@@ -98,8 +98,27 @@ def _field_reference(R) -> dict:
 
 
 def _vibration_reference(R) -> dict:
-    """Phase locking to vibration (docs/references.md rows 8, 21)."""
-    return {}
+    """Phase locking to vibration (docs/references.md rows 8, 21;
+    `ddmm.population.analysis.physiology_vibration`).
+
+    Row 21 is recalled (R): "VS typically > 0.8 at 1:1", so the ranges are
+    broad.  The 1 N rows at 10-60 Hz are ``constrained``: ``tau_rai_s``,
+    ``i_max_rai`` and ``negative_weight_rai`` of the presets were chosen on
+    them.  The 2 N variant (15 and 45 Hz) is ``held out``.
+    """
+    lock = "docs/references.md row 21 (R): FA-I entrain at a fixed phase, VS typically > 0.8 at 1:1"
+    return {
+        "vs_RAI": R(0.8, 1.0, lock, "constrained", "R"),
+        "locked_RAI": R(0.5, 1.0, lock + "; most afferents 1:1 and locked", "constrained", "R"),
+        "vs_2f_ratio_RAI": R(0.0, 1.0, lock + ": one phase per cycle, so VS at 2f < VS at f (locking to both "
+                             "half-cycles gives VS at 2f > VS at f)", "constrained", "R"),
+        "vs_RAI_2N": R(0.8, 1.0, lock + "; a 2 N preload at 15 and 45 Hz, never used to set the model",
+                       "held out", "R"),
+        "locked_RAI_2N": R(0.5, 1.0, lock + "; a 2 N preload at 15 and 45 Hz, never used to set the model",
+                           "held out", "R"),
+        "vs_2f_ratio_RAI_2N": R(0.0, 1.0, lock + "; a 2 N preload at 15 and 45 Hz, never used to set the model",
+                                "held out", "R"),
+    }
 
 
 def _variability_reference(R) -> dict:

@@ -10,7 +10,7 @@ from ddmm.models.currents import AFFERENT_TYPES, type_label
 from ddmm.population.analysis.physiology import FREQUENCIES_HZ
 
 __all__ = ["plot_rest", "plot_on_off", "plot_force_coding", "plot_frequency_tuning", "plot_timing",
-           "physiology_figures"]
+           "plot_cycle_histograms", "physiology_figures"]
 
 
 def plot_rest(data: dict) -> Figure:
@@ -88,11 +88,38 @@ def plot_timing(data: dict) -> Figure:
     return fig
 
 
+def plot_cycle_histograms(data: dict, bins: int = 20) -> Figure:
+    """Cycle histograms: spike phase within the stimulus cycle, one panel per type at one frequency each.
+
+    Parameters
+    ----------
+    data : dict
+        Type code -> ``{"frequency_hz": float, "phases": array of phases in cycles, [0, 1)}`` (the
+        ``phase_locking`` protocol's data; other keys are ignored).
+    bins : int
+        Bins per cycle.
+    """
+    kinds = [k for k in AFFERENT_TYPES if k in data and "phases" in data[k]]
+    fig = Figure(figsize=(3.2 * max(len(kinds), 1), 3.0), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(1, max(len(kinds), 1), squeeze=False)[0])
+    edges = np.linspace(0.0, 1.0, bins + 1)
+    for ax, kind in zip(axes, kinds):
+        phases = np.asarray(data[kind]["phases"], dtype=float)
+        counts, _ = np.histogram(phases, edges)
+        ax.bar(edges[:-1], counts / max(phases.size, 1), width=1.0 / bins, align="edge", color=_TYPE_COLOURS[kind])
+        vs = float(abs(np.exp(2j * np.pi * phases).mean())) if phases.size else float("nan")
+        ax.set_title(f"{type_label(kind)}, {data[kind]['frequency_hz']:g} Hz at 1:1 (VS {vs:.2f})", fontsize=9)
+        ax.set_xlabel("phase (cycles)")
+    axes[0].set_ylabel("fraction of spikes")
+    return fig
+
+
 def physiology_figures(data: dict, human_dsi: dict) -> dict:
     """File name -> Figure for every protocol that ran and has a figure."""
     makers = {"rest": ("rest.png", plot_rest), "on_off": ("on_off_psth.png", plot_on_off),
               "force_coding": ("force_coding.png", plot_force_coding),
-              "frequency": ("frequency_tuning.png", plot_frequency_tuning), "timing": ("timing.png", plot_timing)}
+              "frequency": ("frequency_tuning.png", plot_frequency_tuning), "timing": ("timing.png", plot_timing),
+              "phase_locking": ("cycle_histograms.png", plot_cycle_histograms)}
     out = {name: make(data[protocol]) for protocol, (name, make) in makers.items() if data.get(protocol)}
     if data.get("direction"):
         out["tuning_dsi.png"] = plot_dsi_histograms(data["direction"]["tuning"], human_dsi)

@@ -36,12 +36,15 @@ def filter_sections(cur, lo, hi, sos, g, n_sections, z):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, threshold, gain, normals, col,
-               cv_scale, noisy, signed):
+def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, threshold, negative, gain, normals,
+               col, cv_scale, noisy, signed):
     """The drive d of afferents ``lo..hi`` from their filtered deviations ``x`` (newtons), in place on ``x``.
 
     The derivative of ``order``, adaptation, ``gain`` and receptor noise
-    (``normals[:, col]``, rectified unless ``signed``); ``y1``, ``y2`` and
+    (``normals[:, col]``, rectified unless ``signed``).  A derivative
+    (``order`` > 0) is rectified with the weight ``negative`` on its negative
+    half-wave (1.0: the absolute value, the paper's eqs 2-3; 0.0: half-wave
+    rectification, which keeps the phase of a vibration); ``y1``, ``y2`` and
     ``slow`` are updated in place.  Each step is its own loop over afferents
     with its branches outside, so the loops vectorise (one loop with all the
     branches inside ran 10x slower).  With `filter_sections`, the one
@@ -77,6 +80,9 @@ def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, t
             x[j] = ((cur - 2.0 * y1[j]) + y2[j]) * fs2
             y2[j] = y1[j]
             y1[j] = cur
+    if order > 0 and negative != 1.0:
+        for j in range(n):
+            x[j] = x[j] if x[j] >= 0.0 else -negative * x[j]  # >= 0 from here: abs below leaves it as it is
     if order > 0 and (adapt > 0.0 or threshold > 0.0):
         for j in range(n):
             a = abs(x[j])
@@ -123,7 +129,7 @@ def receptor_noise_keyed(x, lo, hi, key, afferent_id, sample, cv_scale, signed, 
 
 
 @nb.njit(cache=True, nogil=True)
-def stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_adapt, threshold, gain,
+def stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_adapt, threshold, negative, gain,
                   normals, cv_scale, noisy, signed):
     """The linear part of a type's stage: filter (on the deviation from ``offset``), then `stage_tail`.
 
@@ -138,8 +144,8 @@ def stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_ada
         for j in range(m):
             cur[j] = f_a[n, j] - offset[j]
         filter_sections(cur, 0, m, sections, 0, sos.shape[0], z)
-        stage_tail(cur, 0, m, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, threshold, gain, normals, n,
-                   cv_scale, noisy, signed)
+        stage_tail(cur, 0, m, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, threshold, negative, gain,
+                   normals, n, cv_scale, noisy, signed)
         out[n] = cur
     return out
 

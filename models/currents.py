@@ -17,6 +17,10 @@ which the physiological presets switch on (docs/model.md, "What changed in the m
   low-pass before d^2/dt^2 (acceleration: sensitivity grows as f^2 up to the
   cut-off and falls beyond it, a Pacinian band-pass near 150-400 Hz).  A
   scene sampled too slowly to carry RA-II's band is refused (`check_fs`).
+* **Phase-preserving rectification.**  ``negative_weight_rai`` and
+  ``negative_weight_raii`` weight the negative half-wave of the derivative
+  (1.0: the paper's absolute value), so that a vibration excites on one
+  half-cycle and spikes lock to its phase.
 * **Adaptation.**  ``adapt_rai`` makes RA-I adapt to a sustained velocity
   (the rectified velocity minus a low-pass of itself).
 * **Slow adaptation of SA-I.**  ``adapt_sai`` adds ``adapt * (y - slow)``,
@@ -208,6 +212,14 @@ class CurrentParams:
     tau_sai_s, tau_rai_s, tau_raii_s, tau_saii_s : float or None
         Ours: time constant in s of the first-order low-pass on the current
         (after the transducer and the receptor noise); None: none.
+    negative_weight_rai, negative_weight_raii : float
+        Ours: weight (dimensionless, 0 to 1) of the negative half-wave of
+        RA-I's velocity and RA-II's acceleration when they are rectified:
+        ``d = x`` for ``x >= 0`` and ``-w x`` for ``x < 0``.  1.0 is the
+        absolute value of eqs 2-3 (both half-cycles of a vibration excite, so
+        spikes lock to twice its frequency); below 1 the drive keeps the
+        phase of the cycle (one preferred half-cycle), while ``w > 0`` keeps
+        a response to unloading (RA-I's OFF response).
     """
 
     g_sai: float = 5.367  # fitted: CMM SAI SF 47.5 pulses/s (Table III)
@@ -241,6 +253,8 @@ class CurrentParams:
     tau_rai_s: float | None = None
     tau_raii_s: float | None = None
     tau_saii_s: float | None = None
+    negative_weight_rai: float = 1.0
+    negative_weight_raii: float = 1.0
 
     def __post_init__(self):
         for name in ("g_sai", "g_rai", "g_raii", "g_saii", "cutoff_hz", "cutoff_saii_hz", "tau_adapt_sai_s",
@@ -260,6 +274,12 @@ class CurrentParams:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+        for name in ("negative_weight_rai", "negative_weight_raii"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
+                number = isinstance(value, (int, float)) and not isinstance(value, bool)
+                shown = f"{float(value):g}" if number else repr(value)
+                raise ValueError(f"{name} must be a number in [0, 1] (1: the paper's absolute value), got {shown}")
 
     def _own(self, prefix: str, afferent_type: str, suffix: str = "", default=None):
         """The per-type field ``<prefix>_<type><suffix>`` (e.g. ``i_max_raii``), or ``default`` if it has none."""
@@ -290,7 +310,8 @@ class CurrentParams:
                             self.saturation(afferent_type), self._own("i_max", afferent_type),
                             self._own("bias", afferent_type, default=0.0), self._own("tau", afferent_type, "_s"),
                             self._own("threshold", afferent_type, default=0.0),
-                            self._own("highpass", afferent_type, "_hz"))
+                            self._own("highpass", afferent_type, "_hz"),
+                            float(self._own("negative_weight", afferent_type, default=1.0)))
 
 
 @dataclass(frozen=True)
@@ -320,6 +341,9 @@ class CurrentStage:
         Dead zone of the rectified drive (RA-I's velocity threshold, N/s).
     highpass_hz : float or None
         Cut-off of a 2nd-order high-pass in the filter cascade (RA-II), Hz.
+    negative_weight : float
+        Weight of the derivative's negative half-wave when it is rectified
+        (1.0: the absolute value; dimensionless).
     """
 
     afferent_type: str
@@ -335,6 +359,7 @@ class CurrentStage:
     tau_s: float | None = None
     threshold: float = 0.0
     highpass_hz: float | None = None
+    negative_weight: float = 1.0
 
     @property
     def signed(self) -> bool:
@@ -509,7 +534,7 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
     slow = np.zeros(m)
     # The stage kernel with order 0, unit gain and a signed drive returns exactly deviation + offset.
     y = stage_kernel(_stage_sos(shared, float(fs)), np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow,
-                      float(fs), 0, 0.0, 0.0, 0.0, np.ones(m), _NO_NORMALS, np.ones(m), False, True)
+                      float(fs), 0, 0.0, 0.0, 0.0, 1.0, np.ones(m), _NO_NORMALS, np.ones(m), False, True)
     return y, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2, slow=slow, smooth=state.smooth)
 
 
@@ -589,7 +614,7 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     gain = gain if np.ndim(gain) else np.full(m, gain)
     cv_scale = np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs) if noisy else gain
     drive = stage_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, fs, st.derivative,
-                         float(st.adapt), alpha_adapt, float(st.threshold), gain,
+                         float(st.adapt), alpha_adapt, float(st.threshold), float(st.negative_weight), gain,
                          np.ascontiguousarray(normals) if noisy else _NO_NORMALS, cv_scale, noisy, st.signed)
     current = transduce_inplace(drive, st)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
     if st.tau_s is not None:

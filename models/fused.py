@@ -47,7 +47,7 @@ __all__ = ["FusedPipeline", "mix_forces", "mixing_matrix"]
 # Rows of the per-afferent float table.
 _COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA = range(12)
 # Rows of the per-group float and integer tables.
-_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS = range(5)
+_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _NEGATIVE = range(6)
 _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = range(9)
 # Rows of the state after the 2 * n_sections filter rows.
 _OFFSET, _Y1, _Y2, _SLOW, _SMOOTH = range(5)
@@ -244,8 +244,8 @@ def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, st
             f[lo:hi] -= offset[lo:hi]
             filter_sections(f, lo, hi, sos, g, grp_i[_NSEC, g], z)
             stage_tail(f, lo, hi, offset, y1, y2, slow, fs, grp_i[_ORDER, g], grp_f[_ADAPT, g],
-                       grp_f[_ALPHA_ADAPT, g], grp_f[_THRESHOLD, g], gain, _NO_NORMALS, i, cv_scale, False,
-                       grp_i[_SIGNED, g] != 0)
+                       grp_f[_ALPHA_ADAPT, g], grp_f[_THRESHOLD, g], grp_f[_NEGATIVE, g], gain, _NO_NORMALS, i,
+                       cv_scale, False, grp_i[_SIGNED, g] != 0)
             if noisy_any and grp_i[_NOISY, g] != 0:
                 receptor_noise_keyed(f, lo, hi, key, ids, sample0 + i, cv_scale, grp_i[_SIGNED, g] != 0, words,
                                      xi)
@@ -391,12 +391,12 @@ class FusedPipeline:
 
     def _group_tables(self, spans, consts, noise_cv, tuned):
         n_groups, n_sec = len(spans), max([sos.shape[0] for _, sos, _, _ in consts] + [1])
-        grp_f, grp_i = np.zeros((5, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
+        grp_f, grp_i = np.zeros((6, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
         sos_all = np.zeros((n_groups, n_sec, 6))
         for g, ((a, b), (st, sos, alpha_adapt, alpha_smooth)) in enumerate(zip(spans, consts)):
             sos_all[g, :sos.shape[0]] = sos
             plain = st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
-            grp_f[:, g] = [st.adapt, alpha_adapt, st.threshold, alpha_smooth, st.bias]
+            grp_f[:, g] = [st.adapt, alpha_adapt, st.threshold, alpha_smooth, st.bias, st.negative_weight]
             grp_i[:, g] = [sos.shape[0], st.derivative, st.signed, plain, np.any(noise_cv[a:b] > 0),
                            st.tau_s is not None, tuned[a], a, b]
         return grp_f, grp_i, sos_all

@@ -2,6 +2,8 @@
 
 import json
 
+import pytest
+
 from ddmm.experiments.cli import main
 
 
@@ -37,3 +39,23 @@ def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path):
     spec.write_text('[types.SAI]\ncount = 5\n')
     code, _, err = run(capsys, "physiology", "--population", spec, "--properties", "best_frequency_RAII")
     assert code == 2 and err.count("\n") == 1 and "needs RAII afferents" in err
+
+
+def test_phase_locking_rows_and_cycle_histograms(capsys, tmp_path):
+    code, out, _ = run(capsys, "physiology", "--properties", "vs_RAI,vs_RAI_2N", "--json", "--out", tmp_path)
+    assert code == 0 and json.loads(out)["all_pass"] is True
+    assert "cycle_histograms.png" in {p.name for p in tmp_path.iterdir()}
+
+
+def test_cycle_histograms_plot_one_panel_per_type():
+    import numpy as np
+
+    from ddmm.experiments.plot_physiology import plot_cycle_histograms
+
+    phases = np.r_[np.full(30, 0.25), np.full(10, 0.75)]
+    fig = plot_cycle_histograms({"RAI": {"frequency_hz": 20.0, "phases": phases},
+                                 "RAII": {"frequency_hz": 200.0, "phases": np.zeros(0)}, "SAI": {"rates": [1.0]}})
+    axes = fig.get_axes()
+    assert len(axes) == 2 and "FA-I, 20 Hz" in axes[0].get_title() and "VS 0.50" in axes[0].get_title()
+    heights = [p.get_height() for p in axes[0].patches]
+    assert max(heights) == pytest.approx(0.75) and sum(heights) == pytest.approx(1.0)

@@ -113,7 +113,32 @@ def test_sa2_stretch_raises_and_lowers_the_tonic_current():
 
 
 @pytest.mark.parametrize("field,value", [("i_max_rai", -1.0), ("tau_sai_s", 0.0), ("adapt_rai", -0.1),
-                                         ("threshold_rai", np.nan), ("order_raii", 9), ("cutoff_raii_hz", 0.0)])
+                                         ("threshold_rai", np.nan), ("order_raii", 9), ("cutoff_raii_hz", 0.0),
+                                         ("negative_weight_rai", 1.5), ("negative_weight_raii", -0.1),
+                                         ("negative_weight_rai", np.nan)])
 def test_bad_stage_parameters_are_named(field, value):
     with pytest.raises(ValueError, match=field):
         CurrentParams(**{field: value})
+
+
+@pytest.mark.parametrize("kind", ["RAI", "RAII"])
+def test_the_negative_half_wave_is_weighted(kind):
+    """Half-wave drive: loading as the paper's |x|, unloading scaled by negative_weight (1.0: the paper's)."""
+    t = np.arange(2000) / FS
+    f = (0.5 + 0.4 * np.sin(2 * np.pi * 10.0 * t))[:, None]
+    paper, _ = afferent_current(f, FS, kind, CurrentParams())
+    assert np.all(paper >= 0.0)
+    for w in (0.0, 0.25):
+        half, _ = afferent_current(f, FS, kind, CurrentParams(**{f"negative_weight_{kind.lower()}": w}))
+        signed = np.sign(_signed_derivative(f, kind))
+        assert (signed < 0).sum() > 500 and (signed > 0).sum() > 500
+        np.testing.assert_allclose(half[signed > 0, 0], paper[signed > 0, 0], rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(half[signed < 0, 0], w * paper[signed < 0, 0], rtol=1e-9, atol=1e-9)
+
+
+def _signed_derivative(f, kind):
+    """The filtered derivative of the paper's stage with its sign (x 1: no rectification), per sample."""
+    from ddmm.models.currents import filter_force
+    y, _ = filter_force(f, FS, CurrentParams())
+    d = np.diff(np.r_[y[:1], y], axis=0) * FS
+    return (d if kind == "RAI" else np.diff(np.r_[d[:1], d], axis=0) * FS)[:, 0]
