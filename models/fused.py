@@ -35,7 +35,7 @@ import numpy as np
 
 from ddmm.models._stage_kernels import filter_sections, receptor_noise_keyed, stage_tail, transduce_inplace
 from ddmm.models.attenuation import UNTUNED, profile_value
-from ddmm.models.currents import stage_constants
+from ddmm.models.currents import excitability, stage_constants
 from ddmm.models.engines import NeuronState, check_integration, check_stability, get_engine, run_checked, substeps_for
 from ddmm.models.engines.direct import BLOCK, METHOD_CODES, integrate_parts, integrate_range, part_bounds, spike_checks
 from ddmm.models.nap import get_profile, tip_radius
@@ -361,6 +361,10 @@ class FusedPipeline:
         self.grp_f, self.grp_i, self.sos = self._group_tables(spans, consts, noise_cv, nap != UNTUNED)
         self.rows = 2 * self.sos.shape[1]
         self.additive = bool(np.any(noise_sigma > 0))
+        self.excite_cv = np.zeros(self.n_afferents)  # per afferent: its type's trial excitability CV
+        for (a, b) in spans:
+            self.excite_cv[a:b] = params.excite_cv(str(afferent_type[a]))
+        self.excite_any, self._excite = bool(np.any(self.excite_cv > 0)), (None, None)
         self.sigma_idx = np.flatnonzero(noise_sigma > 0).astype(np.int64)
         self.transducers = []  # (columns, stage) per run of one type: numpy's calls cost per call
         for (a, b), (st, *_) in zip(spans, consts):
@@ -457,7 +461,15 @@ class FusedPipeline:
         drive = _front(*args) if bounds is None or bounds.size <= 2 else _front_parts(*args, bounds)
         for cols, stage in self.transducers:
             transduce_inplace(drive[:, cols], stage)
+        if noisy and self.excite_any:
+            drive *= self.excitability(key)  # as `current_core`
         return drive
+
+    def excitability(self, key) -> np.ndarray:
+        """The trial's excitability factor per afferent (`ddmm.models.currents.excitability`), cached per key."""
+        if self._excite[0] != key:
+            self._excite = (key, excitability(key, self.afferent_id, self.excite_cv))
+        return self._excite[1]
 
     def currents(self, forces, state, started, sample0=0, key=None):
         """Currents (mV/ms), shape (n_samples, n_afferents), of forces in newtons.
