@@ -212,10 +212,11 @@ class CurrentParams:
     excite_cv_sai, excite_cv_rai, excite_cv_raii, excite_cv_saii : float
         Ours: trial-to-trial excitability of the spike generator
         (dimensionless coefficient of variation, >= 0; 0: none, the paper).
-        On each trial every afferent's transduced current (before the
-        current low-pass and SA-II's bias) is multiplied by its own lognormal
-        factor of mean 1 and this CV, drawn from the trial's noise key
-        (`excitability`): an undriven afferent stays silent.
+        On each trial every afferent's current is multiplied by its own
+        lognormal factor of mean 1 and this CV, drawn from the trial's noise
+        key (`excitability`), after the log compression ``i_sat`` and
+        before the bound ``i_max`` (which still holds), the low-pass and
+        SA-II's bias: an undriven afferent stays silent.
     """
 
     g_sai: float = 5.367  # fitted: CMM SAI SF 47.5 pulses/s (Table III)
@@ -589,7 +590,8 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     (`ddmm.models._stage_kernels.stage_kernel`) and numpy's vectorised
     transducers; `ddmm.models.fused` runs the same arithmetic for the streaming
     encoder.  ``excite`` (per afferent, dimensionless; `excitability`)
-    multiplies the transduced current of the trial before the low-pass.
+    multiplies the trial's current after the log compression and before
+    the bound ``i_max`` (`transduce_inplace`).
     """
     fs = float(fs)
     st, sos, alpha_adapt, alpha_smooth = stage_constants(params, afferent_type, fs)
@@ -597,8 +599,7 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     noisy = normals is not None and noise_cv is not None and bool(np.any(np.asarray(noise_cv) > 0))
     if st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None:
         drive = gain * np.abs(f_a)  # the paper's eq. 1, no filter
-        current = transduce_inplace(_receptor_noise(drive, normals, noise_cv, fs) if noisy else drive, st)
-        return (current if excite is None else current * excite), None
+        return transduce_inplace(_receptor_noise(drive, normals, noise_cv, fs) if noisy else drive, st, excite), None
     if state is None:
         state = initial_filter_state(f_a[0], fs, params, afferent_type)
     m = f_a.shape[1]
@@ -610,9 +611,7 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     drive = stage_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, fs, st.derivative,
                          float(st.adapt), alpha_adapt, float(st.threshold), gain,
                          np.ascontiguousarray(normals) if noisy else _NO_NORMALS, cv_scale, noisy, st.signed)
-    current = transduce_inplace(drive, st)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
-    if excite is not None:
-        current *= excite
+    current = transduce_inplace(drive, st, excite)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
     if st.tau_s is not None:
         current = smooth_kernel(current, smooth, alpha_smooth)
     if st.bias != 0.0:

@@ -366,9 +366,10 @@ class FusedPipeline:
             self.excite_cv[a:b] = params.excite_cv(str(afferent_type[a]))
         self.excite_any, self._excite = bool(np.any(self.excite_cv > 0)), (None, None)
         self.sigma_idx = np.flatnonzero(noise_sigma > 0).astype(np.int64)
-        self.transducers = []  # (columns, stage) per run of one type: numpy's calls cost per call
+        self.transducers, self._plain = [], []  # (columns, stage) per run of one type: numpy's calls cost per call
         for (a, b), (st, *_) in zip(spans, consts):
             if st.i_sat is None and st.i_max is None and not st.signed:
+                self._plain.append(slice(int(a), int(b)))
                 continue
             if self.transducers and self.transducers[-1][1] is st and self.transducers[-1][0].stop == a:
                 self.transducers[-1] = (slice(self.transducers[-1][0].start, int(b)), st)
@@ -459,10 +460,12 @@ class FusedPipeline:
         # The parallel kernel is called from here, never from a cached kernel
         # (numba's cache does not track a cached caller's parallel callee).
         drive = _front(*args) if bounds is None or bounds.size <= 2 else _front_parts(*args, bounds)
+        excite = self.excitability(key) if noisy and self.excite_any else None
         for cols, stage in self.transducers:
-            transduce_inplace(drive[:, cols], stage)
-        if noisy and self.excite_any:
-            drive *= self.excitability(key)  # as `current_core`
+            transduce_inplace(drive[:, cols], stage, None if excite is None else excite[cols])  # as `current_core`
+        if excite is not None:
+            for cols in self._plain:  # runs without a transducer: the factor alone
+                drive[:, cols] *= excite[cols]
         return drive
 
     def excitability(self, key) -> np.ndarray:
