@@ -412,6 +412,8 @@ def _extend(module_name: str) -> None:
 
     global PROTOCOLS
     module = import_module(f"ddmm.population.analysis.{module_name}")
+    if not hasattr(module, "RUNNERS"):  # imported first, so still importing: it calls this at its end
+        return
     clash = (set(module.PROPERTIES) & set(PROPERTIES)) | (set(module.PROTOCOLS) & set(PROTOCOLS))
     if clash:
         raise RuntimeError(f"{module_name} redefines {sorted(clash)}")

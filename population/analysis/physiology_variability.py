@@ -11,14 +11,14 @@ a 0.6 s hold, a release at 10 N/s).  Per type (SA-I, FA-I, FA-II):
 
 `variability_stats` also serves the variants the rows were not tuned on
 (another force, another ramp rate, other seeds; docs/model.md).  Registered
-through `ddmm.population.analysis.physiology._extend`: import
-`ddmm.population.analysis.physiology` before this module (it imports it).
+through `ddmm.population.analysis.physiology._extend` (in either import order).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ddmm.population.analysis import physiology as _core
 from ddmm.population.analysis.physiology import Property, _knots, _of, _run
 from ddmm.population.stimuli.scenes import Stage
 
@@ -96,3 +96,6 @@ def _variability(population, context):
 
 
 RUNNERS = {"variability": _variability}
+
+if PROTOCOLS[0] not in _core.PROTOCOLS:  # imported before `physiology`, which then skipped it
+    _core._extend(__name__.rsplit(".", 1)[1])
