@@ -414,6 +414,8 @@ def _extend(module_name: str) -> None:
     module = import_module(f"ddmm.population.analysis.{module_name}")
     if not hasattr(module, "RUNNERS"):  # imported first, so still importing: it calls this at its end
         return
+    if all(PROPERTIES.get(k) is v for k, v in module.PROPERTIES.items()) and set(module.PROTOCOLS) <= set(PROTOCOLS):
+        return  # it registered itself while this call imported it
     clash = (set(module.PROPERTIES) & set(PROPERTIES)) | (set(module.PROTOCOLS) & set(PROTOCOLS))
     if clash:
         raise RuntimeError(f"{module_name} redefines {sorted(clash)}")
