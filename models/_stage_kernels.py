@@ -160,11 +160,14 @@ def smooth_kernel(x, c, alpha):
     return x
 
 
-def transduce_inplace(drive, stage):
+def transduce_inplace(drive, stage, excite=None):
     """Log compression and saturation of ``|drive|``, in place.
 
     ``stage.i_sat`` and ``stage.i_max`` in mV/ms; the sign of SA-II's signed
-    drive is restored afterwards.
+    drive is restored afterwards.  ``excite`` (per column, dimensionless: the
+    trial excitability of `ddmm.models.currents.excitability`) multiplies
+    the current after the log compression and before the bound, so
+    ``i_max`` still bounds it.
     """
     negative = np.signbit(drive) if stage.signed else None
     if stage.signed:
@@ -173,6 +176,8 @@ def transduce_inplace(drive, stage):
         drive /= stage.i_sat
         np.log1p(drive, out=drive)
         drive *= stage.i_sat
+    if excite is not None:
+        drive *= excite
     if stage.i_max is not None:
         drive /= stage.i_max
         np.tanh(drive, out=drive)

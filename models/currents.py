@@ -80,6 +80,7 @@ __all__ = [
     "filter_force",
     "afferent_current",
     "current_core",
+    "excitability",
     "check_fs",
     "TYPE_LABELS",
     "type_label",
@@ -220,6 +221,14 @@ class CurrentParams:
         spikes lock to twice its frequency); below 1 the drive keeps the
         phase of the cycle (one preferred half-cycle), while ``w > 0`` keeps
         a response to unloading (RA-I's OFF response).
+    excite_cv_sai, excite_cv_rai, excite_cv_raii, excite_cv_saii : float
+        Ours: trial-to-trial excitability of the spike generator
+        (dimensionless coefficient of variation, >= 0; 0: none, the paper).
+        On each trial every afferent's current is multiplied by its own
+        lognormal factor of mean 1 and this CV, drawn from the trial's noise
+        key (`excitability`), after the log compression ``i_sat`` and
+        before the bound ``i_max`` (which still holds), the low-pass and
+        SA-II's bias: an undriven afferent stays silent.
     """
 
     g_sai: float = 5.367  # fitted: CMM SAI SF 47.5 pulses/s (Table III)
@@ -255,6 +264,10 @@ class CurrentParams:
     tau_saii_s: float | None = None
     negative_weight_rai: float = 1.0
     negative_weight_raii: float = 1.0
+    excite_cv_sai: float = 0.0
+    excite_cv_rai: float = 0.0
+    excite_cv_raii: float = 0.0
+    excite_cv_saii: float = 0.0
 
     def __post_init__(self):
         for name in ("g_sai", "g_rai", "g_raii", "g_saii", "cutoff_hz", "cutoff_saii_hz", "tau_adapt_sai_s",
@@ -270,7 +283,8 @@ class CurrentParams:
                 continue
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 8:
                 raise ValueError(f"{name} must be an int in [1, 8], got {value!r}")
-        for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii"):
+        for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii", "excite_cv_sai",
+                     "excite_cv_rai", "excite_cv_raii", "excite_cv_saii"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -289,6 +303,10 @@ class CurrentParams:
         """The gain of ``afferent_type`` (``"SAI"``, ``"RAI"``, ``"RAII"`` or ``"SAII"``)."""
         afferent_type = normalize_type(afferent_type)
         return self._own("g", afferent_type)
+
+    def excite_cv(self, afferent_type: str) -> float:
+        """The trial-to-trial excitability CV of ``afferent_type`` (dimensionless; 0: none)."""
+        return float(self._own("excite_cv", normalize_type(afferent_type)))
 
     def saturation(self, afferent_type: str) -> float | None:
         """The log-compression scale of ``afferent_type`` in mV/ms (None: linear; SA-II has none)."""
@@ -587,7 +605,7 @@ def afferent_current(
     return current_core(f_a, fs, afferent_type, params, state, scale)
 
 
-def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals=None, noise_cv=None):
+def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals=None, noise_cv=None, excite=None):
     """`afferent_current` without validation (the hot path of `simulate`).
 
     ``normals`` (shape (n_afferents, n_samples), standard normal draws) and
@@ -596,7 +614,9 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     after the paper's unfiltered SAI runs in one numba pass
     (`ddmm.models._stage_kernels.stage_kernel`) and numpy's vectorised
     transducers; `ddmm.models.fused` runs the same arithmetic for the streaming
-    encoder.
+    encoder.  ``excite`` (per afferent, dimensionless; `excitability`)
+    multiplies the trial's current after the log compression and before
+    the bound ``i_max`` (`transduce_inplace`).
     """
     fs = float(fs)
     st, sos, alpha_adapt, alpha_smooth = stage_constants(params, afferent_type, fs)
@@ -604,7 +624,7 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     noisy = normals is not None and noise_cv is not None and bool(np.any(np.asarray(noise_cv) > 0))
     if st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None:
         drive = gain * np.abs(f_a)  # the paper's eq. 1, no filter
-        return transduce_inplace(_receptor_noise(drive, normals, noise_cv, fs) if noisy else drive, st), None
+        return transduce_inplace(_receptor_noise(drive, normals, noise_cv, fs) if noisy else drive, st, excite), None
     if state is None:
         state = initial_filter_state(f_a[0], fs, params, afferent_type)
     m = f_a.shape[1]
@@ -616,7 +636,7 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     drive = stage_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, fs, st.derivative,
                          float(st.adapt), alpha_adapt, float(st.threshold), float(st.negative_weight), gain,
                          np.ascontiguousarray(normals) if noisy else _NO_NORMALS, cv_scale, noisy, st.signed)
-    current = transduce_inplace(drive, st)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
+    current = transduce_inplace(drive, st, excite)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
     if st.tau_s is not None:
         current = smooth_kernel(current, smooth, alpha_smooth)
     if st.bias != 0.0:
@@ -635,6 +655,34 @@ def stage_constants(params: CurrentParams, afferent_type: str, fs: float):
     alpha_adapt = float(-np.expm1(-1.0 / (fs * stage.tau_adapt_s)))
     alpha_smooth = 0.0 if stage.tau_s is None else float(-np.expm1(-1.0 / (fs * stage.tau_s)))
     return stage, _stage_sos(stage, fs), alpha_adapt, alpha_smooth
+
+
+#: The counter (sample index) of the per-trial excitability draw: no scene reaches 2**32 - 1 samples.
+EXCITE_SAMPLE = 0xFFFFFFFF
+
+
+def excitability(key, afferent_id, cv) -> np.ndarray:
+    """Per-trial excitability factors: lognormal, mean 1, coefficient of variation ``cv`` (per afferent).
+
+    ``exp(s z - s^2 / 2)`` with ``s^2 = log(1 + cv^2)`` and ``z`` the
+    standard normal of (trial key ``key``, afferent id, sample
+    `EXCITE_SAMPLE`) (`ddmm.models.rng.normal`): a pure function of
+    (seed, condition, trial, afferent), so every chunking, engine and
+    process draws the same factor.
+
+    Examples
+    --------
+    >>> from ddmm.models.rng import stream_key
+    >>> e = excitability(stream_key(0, 0, 0), [3, 4], [0.0, 0.2])
+    >>> float(e[0]), bool(e[1] != 1.0)
+    (1.0, True)
+    """
+    from ddmm.models.rng import normals
+
+    cv = np.asarray(cv, dtype=float)
+    s = np.sqrt(np.log1p(cv * cv))
+    z = normals(int(key), np.asarray(afferent_id, dtype=np.int64), EXCITE_SAMPLE, 1)[:, 0]
+    return np.exp(s * z - 0.5 * s * s)
 
 
 def _receptor_noise(drive, normals, noise_cv, fs):

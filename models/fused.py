@@ -35,7 +35,7 @@ import numpy as np
 
 from ddmm.models._stage_kernels import filter_sections, receptor_noise_keyed, stage_tail, transduce_inplace
 from ddmm.models.attenuation import UNTUNED, profile_value
-from ddmm.models.currents import stage_constants
+from ddmm.models.currents import excitability, stage_constants
 from ddmm.models.engines import NeuronState, check_integration, check_stability, get_engine, run_checked, substeps_for
 from ddmm.models.engines.direct import BLOCK, METHOD_CODES, integrate_parts, integrate_range, part_bounds, spike_checks
 from ddmm.models.nap import get_profile, tip_radius
@@ -361,10 +361,15 @@ class FusedPipeline:
         self.grp_f, self.grp_i, self.sos = self._group_tables(spans, consts, noise_cv, nap != UNTUNED)
         self.rows = 2 * self.sos.shape[1]
         self.additive = bool(np.any(noise_sigma > 0))
+        self.excite_cv = np.zeros(self.n_afferents)  # per afferent: its type's trial excitability CV
+        for (a, b) in spans:
+            self.excite_cv[a:b] = params.excite_cv(str(afferent_type[a]))
+        self.excite_any, self._excite = bool(np.any(self.excite_cv > 0)), (None, None)
         self.sigma_idx = np.flatnonzero(noise_sigma > 0).astype(np.int64)
-        self.transducers = []  # (columns, stage) per run of one type: numpy's calls cost per call
+        self.transducers, self._plain = [], []  # (columns, stage) per run of one type: numpy's calls cost per call
         for (a, b), (st, *_) in zip(spans, consts):
             if st.i_sat is None and st.i_max is None and not st.signed:
+                self._plain.append(slice(int(a), int(b)))
                 continue
             if self.transducers and self.transducers[-1][1] is st and self.transducers[-1][0].stop == a:
                 self.transducers[-1] = (slice(self.transducers[-1][0].start, int(b)), st)
@@ -455,9 +460,19 @@ class FusedPipeline:
         # The parallel kernel is called from here, never from a cached kernel
         # (numba's cache does not track a cached caller's parallel callee).
         drive = _front(*args) if bounds is None or bounds.size <= 2 else _front_parts(*args, bounds)
+        excite = self.excitability(key) if noisy and self.excite_any else None
         for cols, stage in self.transducers:
-            transduce_inplace(drive[:, cols], stage)
+            transduce_inplace(drive[:, cols], stage, None if excite is None else excite[cols])  # as `current_core`
+        if excite is not None:
+            for cols in self._plain:  # runs without a transducer: the factor alone
+                drive[:, cols] *= excite[cols]
         return drive
+
+    def excitability(self, key) -> np.ndarray:
+        """The trial's excitability factor per afferent (`ddmm.models.currents.excitability`), cached per key."""
+        if self._excite[0] != key:
+            self._excite = (key, excitability(key, self.afferent_id, self.excite_cv))
+        return self._excite[1]
 
     def currents(self, forces, state, started, sample0=0, key=None):
         """Currents (mV/ms), shape (n_samples, n_afferents), of forces in newtons.

@@ -12,12 +12,14 @@ condition, what can be skipped without changing a single spike:
   and zero normal force, zero receptive-field weight, zero gain, or AF = 0;
   for SA-II no bias and no shear): they stay at their resting fixed point
   and never spike.  Drive-proportional noise (``noise_cv``) is zero with the
-  drive, so it does not stop an afferent from being skipped;
+  drive, so it does not stop an afferent from being skipped; nor does the
+  trial excitability (``excite_cv_<type>``), a factor on the current;
 * noise generation for afferents without noise;
 * recording variables nobody asked for.
 
 Noiseless afferents with identical parameters share one integration, and
-their trials collapse to one.  With ``enabled=False`` nothing is skipped (the
+their trials collapse to one; an afferent with receptor noise or a trial
+excitability is simulated on every trial.  With ``enabled=False`` nothing is skipped (the
 brute-force reference that tests hold the plan to).
 """
 
@@ -188,6 +190,12 @@ def _quiet(pop, sel, scene, scale, af_stage, af_constant):
     return np.where(stretch, stretched & (bias == 0.0), pressed) & (pop.noise_sigma[sel] == 0.0)
 
 
+def _excitable(pop, sel) -> np.ndarray:
+    """Afferents whose type has a trial excitability (``excite_cv_<type>``): their current differs by trial."""
+    types = [t for t in AFFERENT_TYPES if pop.current.excite_cv(t) > 0]
+    return np.isin(pop.afferent_type[sel], types)
+
+
 def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
     n, local = sel.size, scene.sites is not None
     # A multi-site scene's local shear is a weighted sum of the sites' and can cross F_TH where none does.
@@ -200,7 +208,7 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
         weights = (np.ones(n) if scene.contact is None else
                    population_weight(pop, scene.contact)[sel])
     scale = pop.gain[sel] * (1.0 if weights is None else weights)
-    noisy = (pop.noise_sigma[sel] > 0) | (pop.noise_cv[sel] > 0)
+    noisy = (pop.noise_sigma[sel] > 0) | (pop.noise_cv[sel] > 0) | _excitable(pop, sel)
     if not enabled:
         return ConditionPlan(scene.name, scene.n_samples, True, af_constant, weights,
                              np.empty(0, np.int64), np.full(n, -1, np.int64))

@@ -125,7 +125,7 @@ class Encoder:
         self._pipeline = block_pipeline(pop, self.fs, self.sites, scale, self.no_shear)
         # Read once: a push is latency-bound, and the thread count is fixed for the encoder's life.
         self._parts = self._engine.stream_parts(len(pop))
-        noisy = np.any(pop.noise_sigma > 0) or np.any(pop.noise_cv > 0)
+        noisy = np.any(pop.noise_sigma > 0) or np.any(pop.noise_cv > 0) or self._pipeline.excite_any
         self._key = noise_key(self.seed, 0, 0) if noisy else None
 
     def reset(self) -> None:

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ddmm.models.attenuation import UNTUNED, attenuated_force, attenuation_factor, profile_factor, stretch_drive
-from ddmm.models.currents import CurrentParams, current_core
+from ddmm.models.currents import CurrentParams, current_core, excitability
 from ddmm.models.fused import FusedPipeline
 from ddmm.models.rng import normals as keyed_normals
 from ddmm.population import load_spec
@@ -33,8 +33,8 @@ def forces(seed, n=400):
     return np.column_stack([shear * np.cos(angle), shear * np.sin(angle), fz])
 
 
-def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals):
-    """The stage-by-stage path: AF, F_A or stretch, each type's stage, additive noise."""
+def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite=None):
+    """The stage-by-stage path: AF, F_A or stretch, each type's stage (with the trial ``excite``), additive noise."""
     fx, fy, fz = f.T
     drive = np.empty((f.shape[0], len(TYPES)))
     for j, (kind, nap) in enumerate(zip(TYPES, NAPS)):
@@ -50,7 +50,8 @@ def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals):
     for kind in dict.fromkeys(TYPES):
         cols = np.flatnonzero(np.array(TYPES) == kind)
         current[:, cols], _ = current_core(drive[:, cols], FS, kind, params, None, scale[cols],
-                                           None if normals is None else normals[cols], cv[cols])
+                                           None if normals is None else normals[cols], cv[cols],
+                                           None if excite is None else excite[cols])
     if normals is not None and np.any(sigma > 0):
         current += (normals * (sigma / np.sqrt(1000.0 / FS))[:, None]).T
     return current
@@ -70,7 +71,8 @@ def test_fused_currents_equal_the_stage_by_stage_path(seed, no_shear, physio, no
     ids = np.arange(100, 100 + n)
     key = seed + 1 if noisy else None
     normals = keyed_normals(key, ids, 0, f.shape[0]) if noisy else None
-    expected = reference(f, params, no_shear, scale, cv, sigma, theta, k, normals)
+    excite = excitability(key, ids, [params.excite_cv(t) for t in TYPES]) if noisy else None
+    expected = reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite)
     plan = FusedPipeline(TYPES, NAPS, theta, k, scale, cv, sigma, params, FS, no_shear, 0.1, ids)
     state = plan.new_state()
     parts = [plan.currents(f[a:b], state, a > 0, a, key)
@@ -90,7 +92,8 @@ def test_fused_currents_in_time_slices_equal_the_stage_by_stage_path(monkeypatch
     cv, sigma = np.full(n, 0.4), np.where(np.array(TYPES) == "SAII", 0.5, 0.0)
     f, ids = forces(5), np.arange(n)
     normals = keyed_normals(9, ids, 0, f.shape[0])
-    expected = reference(f, PHYSIO, "smooth", scale, cv, sigma, theta, k, normals)
+    excite = excitability(9, ids, [PHYSIO.excite_cv(t) for t in TYPES])
+    expected = reference(f, PHYSIO, "smooth", scale, cv, sigma, theta, k, normals, excite)
     plan = FusedPipeline(TYPES, NAPS, theta, k, scale, cv, sigma, PHYSIO, FS, "smooth", 0.1, ids)
     np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False, 0, 9), expected)
 

@@ -45,7 +45,8 @@ def test_multi_site_runs_are_identical_on_workers(client, pop):
     assert ds.identical(ref) and ref.spike_count.sum() > 100
 
 
-def test_workers_keep_their_own_brian2_cache(client):
+def test_workers_keep_their_own_brian2_cache(client, pop):
+    simulate(pop.select(range(20)), birznieks(90.0), engine="direct", seed=4, quiet=True, scheduler=client)  # plugin
     dirs = client.run(lambda: os.environ.get("DDMM_CACHE_DIR"))
     assert len(set(dirs.values())) == 2 and all("workers" in d for d in dirs.values())
 
