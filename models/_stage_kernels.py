@@ -146,18 +146,19 @@ def stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_ada
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def dynamic_step(x, c, alpha, depth):
-    """One sample of the dynamic response on the current: ``c += alpha (x - c)``; ``max(x + depth (x - c), 0)``."""
+def dynamic_step(x, c, alpha, depth, fall):
+    """One sample of the dynamic response on the current: ``c += alpha (x - c)``;
+    ``max(x + depth (x - c) - fall c, 0)``."""
     c = c + alpha * (x - c)
-    return max(x + depth * (x - c), 0.0), c
+    return max((x + depth * (x - c)) - fall * c, 0.0), c
 
 
 @nb.njit(cache=True, nogil=True)
-def dynamic_kernel(x, c, alpha, depth):
+def dynamic_kernel(x, c, alpha, depth, fall):
     """`dynamic_step` along axis 0, in place on ``x``, with state ``c`` (updated)."""
     for n in range(x.shape[0]):
         for j in range(x.shape[1]):
-            x[n, j], c[j] = dynamic_step(x[n, j], c[j], alpha, depth)
+            x[n, j], c[j] = dynamic_step(x[n, j], c[j], alpha, depth, fall)
     return x
 
 

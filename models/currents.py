@@ -227,13 +227,18 @@ class CurrentParams:
         noise-free runs (no key) start at rest.
     dynamic_sai : float
         Ours: depth of SA-I's dynamic response on the *current*
-        (dimensionless, 0: none): ``I <- max(I + dynamic_sai (I - J), 0)``
+        (dimensionless, 0: none): ``I <- max(I + dynamic_sai (I - J) - fall_sai J, 0)``
         with ``J`` a first-order low-pass of the current (time constant
         ``tau_dynamic_sai_s``), after the transducer and the current's
         low-pass.  Being after the transducer, the overshoot in fast loading
         and its decay through a hold are fractions of the current at every
         force (the force-level ``adapt_sai`` is squashed by the log
         compression and the bound at high forces).
+    fall_sai : float
+        Ours: SA-I's lasting adaptation on the current (dimensionless, in
+        [0, 1); 0: none): ``fall_sai * J`` is subtracted as well, so a held
+        current settles at ``(1 - fall_sai)`` of its value with time
+        constant ``tau_dynamic_sai_s``, a fraction at every force.
     tau_dynamic_sai_s : float
         Ours: time constant of that low-pass in s.
     i_max_sai, i_max_rai, i_max_raii, i_max_saii : float or None
@@ -271,6 +276,7 @@ class CurrentParams:
     bias_cv_saii: float = 0.0
     phase_saii: float = 0.0
     dynamic_sai: float = 0.0
+    fall_sai: float = 0.0
     tau_dynamic_sai_s: float = 1.0
     i_max_sai: float | None = None
     i_max_rai: float | None = None
@@ -295,11 +301,13 @@ class CurrentParams:
                 continue
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 8:
                 raise ValueError(f"{name} must be an int in [1, 8], got {value!r}")
+        if not self.fall_sai < 1.0:
+            raise ValueError(f"fall_sai must be a number in [0, 1), got {self.fall_sai!r}")
         if isinstance(self.phase_saii, bool) or not isinstance(self.phase_saii, (int, float)) \
                 or not 0.0 <= self.phase_saii <= 1.0:
             raise ValueError(f"phase_saii must be a number in [0, 1], got {self.phase_saii!r}")
         for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii", "normal_saii",
-                     "bias_cv_saii", "dynamic_sai"):
+                     "bias_cv_saii", "dynamic_sai", "fall_sai"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -335,7 +343,7 @@ class CurrentParams:
                             self._own("threshold", afferent_type, default=0.0),
                             self._own("highpass", afferent_type, "_hz"), self._own("dynamic", afferent_type, default=0.0),
                             self._own("tau_dynamic", afferent_type, "_s", 1.0),
-                            self._own("bias_cv", afferent_type, default=0.0))
+                            self._own("bias_cv", afferent_type, default=0.0), self._own("fall", afferent_type, default=0.0))
 
 
 @dataclass(frozen=True)
@@ -370,6 +378,8 @@ class CurrentStage:
         dynamic response (SA-I's ``dynamic_sai``).
     bias_cv : float
         Spread of the tonic current across units (SA-II's ``bias_cv_saii``).
+    fall : float
+        Lasting adaptation of the current (SA-I's ``fall_sai``).
     """
 
     afferent_type: str
@@ -388,6 +398,7 @@ class CurrentStage:
     dynamic: float = 0.0
     tau_dynamic_s: float = 1.0
     bias_cv: float = 0.0
+    fall: float = 0.0
 
     @property
     def signed(self) -> bool:
@@ -653,8 +664,8 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     if st.tau_s is not None:
         current = smooth_kernel(current, smooth, alpha_smooth)
     dyn = np.zeros(m) if state.dyn is None else state.dyn.copy()
-    if st.dynamic > 0.0:
-        current = dynamic_kernel(current, dyn, _alpha(st.tau_dynamic_s, fs), float(st.dynamic))
+    if st.dynamic > 0.0 or st.fall > 0.0:
+        current = dynamic_kernel(current, dyn, _alpha(st.tau_dynamic_s, fs), float(st.dynamic), float(st.fall))
     if st.bias != 0.0:
         current += tonic_current(st, afferent_id, m)
     return current, FilterState(zi, state.offset, y1, y2, slow, smooth, dyn)

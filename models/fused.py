@@ -47,7 +47,7 @@ __all__ = ["FusedPipeline", "mix_forces", "mixing_matrix"]
 # Rows of the per-afferent float table.
 _COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA, _TONIC = range(13)
 # Rows of the per-group float and integer tables.
-_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _DYN, _ALPHA_DYN = range(7)
+_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _DYN, _ALPHA_DYN, _FALL = range(8)
 _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = range(9)
 # Rows of the state after the 2 * n_sections filter rows.
 _OFFSET, _Y1, _Y2, _SLOW, _SMOOTH, _DYNC = range(6)
@@ -279,11 +279,11 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i
                 for j in range(hi - lo):
                     c[j] = c[j] + alpha * (x[j] - c[j])  # `smooth_kernel`
                     x[j] = c[j]
-            depth = grp_f[_DYN, g]
-            if depth > 0.0:
+            depth, fall = grp_f[_DYN, g], grp_f[_FALL, g]
+            if depth > 0.0 or fall > 0.0:
                 c, alpha = dync[lo:hi], grp_f[_ALPHA_DYN, g]
                 for j in range(hi - lo):
-                    x[j], c[j] = dynamic_step(x[j], c[j], alpha, depth)
+                    x[j], c[j] = dynamic_step(x[j], c[j], alpha, depth, fall)
             if bias != 0.0:
                 tonic = aff_f[_TONIC, lo:hi]
                 for j in range(hi - lo):
@@ -406,13 +406,13 @@ class FusedPipeline:
 
     def _group_tables(self, spans, consts, noise_cv, tuned):
         n_groups, n_sec = len(spans), max([sos.shape[0] for _, sos, _, _ in consts] + [1])
-        grp_f, grp_i = np.zeros((7, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
+        grp_f, grp_i = np.zeros((8, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
         sos_all = np.zeros((n_groups, n_sec, 6))
         for g, ((a, b), (st, sos, alpha_adapt, alpha_smooth)) in enumerate(zip(spans, consts)):
             sos_all[g, :sos.shape[0]] = sos
             plain = st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
             grp_f[:, g] = [st.adapt, alpha_adapt, st.threshold, alpha_smooth, st.bias, st.dynamic,
-                           float(-np.expm1(-1.0 / (self.fs * st.tau_dynamic_s)))]  # `currents._alpha`
+                           float(-np.expm1(-1.0 / (self.fs * st.tau_dynamic_s))), st.fall]  # `currents._alpha`
             grp_i[:, g] = [sos.shape[0], st.derivative, st.signed, plain, np.any(noise_cv[a:b] > 0),
                            st.tau_s is not None, tuned[a], a, b]
         return grp_f, grp_i, sos_all
