@@ -87,7 +87,8 @@ def _physiology_reference() -> dict:
 
 def _dynamic_reference(R) -> dict:
     """Reference ranges of the protocol modules beyond the core battery (phase locking, variability, shear)."""
-    return {**_vibration_reference(R), **_variability_reference(R), **_shear_reference(R), **_field_reference(R)}
+    return {**_vibration_reference(R), **_variability_reference(R), **_shear_reference(R), **_slow_reference(R),
+            **_field_reference(R)}
 
 
 def _field_reference(R) -> dict:
@@ -146,6 +147,29 @@ def _variability_reference(R) -> dict:
 def _shear_reference(R) -> dict:
     """Tangential force magnitude, SA-II and SA-I dynamics (docs/references.md rows 4-6, 12, 22, 24)."""
     return {}
+
+
+def _slow_reference(R) -> dict:
+    """SA-II under normal force and at rest, SA-I dynamics and adaptation (docs/references.md rows 1, 4, 5, 12, 24;
+    `ddmm.population.analysis.physiology_slow`)."""
+    inf = float("inf")
+    rest = "docs/references.md rows 1, 24: SA-II resting discharge differs from unit to unit, about 5-20 imp/s"
+    adapt = ("docs/references.md row 4: SA keep firing and adapt through a hold (monkey: -38% over 12 s); the fall "
+             "neither vanishes nor is complete (R: a broad range)")
+    peak = "docs/references.md row 5: SA-I peak 100-300 imp/s in fast loading against 10-60 in the plateau"
+    return {
+        "rest_spread_SAII": R(4.0, 15.0, rest + "; bias_cv_saii set by hand to it", "constrained", "R"),
+        "rest_active_SAII": R(0.5, 1.0, rest + ": most SA-II fire at rest", "held out", "R"),
+        "start_synchrony_SAII": R(0.0, 0.5, "docs/references.md row 24: units fire independently (each its own "
+                                  "rate and phase); 1 = every unit in step", "held out", "R"),
+        "normal_coding_SAII": R(1.05, inf, "docs/references.md rows 12, 24: every nail-border SA-II responded to "
+                                "4 N normal forces (rates rise with normal force)", "held out", "V"),
+        "adaptation_05N_SAI": R(0.1, 0.75, adapt + "; dynamic_sai set by hand to it", "constrained", "V"),
+        "adaptation_2N_SAI": R(0.1, 0.75, adapt, "held out", "V"),
+        "adaptation_8N_SAI": R(0.1, 0.75, adapt + "; dynamic_sai set by hand to it", "constrained", "V"),
+        "peak_plateau_SAI": R(1.5, inf, peak + "; dynamic_sai set by hand to it", "constrained", "R"),
+        "peak_plateau_2N_SAI": R(1.5, inf, peak + " (a variant: 20 N/s to 2 N)", "held out", "R"),
+    }
 
 
 def _core_reference(R) -> dict:

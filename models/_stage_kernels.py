@@ -12,7 +12,8 @@ import numpy as np
 
 from ddmm.models.rng import normal_row
 
-__all__ = ["filter_sections", "stage_tail", "receptor_noise_keyed", "stage_kernel", "smooth_kernel", "transduce_inplace"]
+__all__ = ["filter_sections", "stage_tail", "receptor_noise_keyed", "stage_kernel", "smooth_kernel", "dynamic_step",
+           "dynamic_kernel", "transduce_inplace"]
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -148,6 +149,23 @@ def stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_ada
                    normals, n, cv_scale, noisy, signed)
         out[n] = cur
     return out
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def dynamic_step(x, c, alpha, depth, fall):
+    """One sample of the dynamic response on the current: ``c += alpha (x - c)``;
+    ``max(x + depth (x - c) - fall c, 0)``."""
+    c = c + alpha * (x - c)
+    return max((x + depth * (x - c)) - fall * c, 0.0), c
+
+
+@nb.njit(cache=True, nogil=True)
+def dynamic_kernel(x, c, alpha, depth, fall):
+    """`dynamic_step` along axis 0, in place on ``x``, with state ``c`` (updated)."""
+    for n in range(x.shape[0]):
+        for j in range(x.shape[1]):
+            x[n, j], c[j] = dynamic_step(x[n, j], c[j], alpha, depth, fall)
+    return x
 
 
 @nb.njit(cache=True, nogil=True)

@@ -201,12 +201,14 @@ def blend_no_shear(profile_af, f_s, f_th: float = F_TH) -> np.ndarray:
     return out
 
 
-def stretch_drive(fx, fy, af, opponent: float = 0.0) -> np.ndarray:
-    """SA-II's signed stretch drive ``F_S (AF - opponent (1 - AF))`` in newtons.
+def stretch_drive(fx, fy, af, opponent: float = 0.0, fz=None, normal: float = 0.0) -> np.ndarray:
+    """SA-II's signed stretch drive ``F_S (AF - opponent (1 - AF))`` in newtons, plus ``normal * F_Z``.
 
     ``af`` is the profile's AF (shape (n_samples, n_afferents)) on the shear
     direction; stretch along the preferred direction drives the afferent,
-    stretch against it lowers the drive when ``opponent > 0``.
+    stretch against it lowers the drive when ``opponent > 0``.  With
+    ``normal > 0`` (`CurrentParams.normal_saii`) the normal force ``fz``
+    (N, shape (n_samples,) or (n_samples, n_afferents)) adds to it.
 
     Examples
     --------
@@ -215,7 +217,11 @@ def stretch_drive(fx, fy, af, opponent: float = 0.0) -> np.ndarray:
     """
     f_s = shear_magnitude(fx, fy)
     af = np.asarray(af, dtype=float)
-    return f_s[:, None] * (af - opponent * (1.0 - af))
+    drive = f_s[:, None] * (af - opponent * (1.0 - af))
+    if normal != 0.0:
+        fz = np.asarray(fz, dtype=float)
+        drive = drive + normal * (fz[:, None] if fz.ndim == 1 else fz)
+    return drive
 
 
 @nb.njit(cache=True, nogil=True, inline="always")

@@ -66,7 +66,7 @@ from functools import lru_cache
 import numpy as np
 
 from ddmm.models._cache import cache_root
-from ddmm.models._stage_kernels import smooth_kernel, stage_kernel, transduce_inplace
+from ddmm.models._stage_kernels import dynamic_kernel, smooth_kernel, stage_kernel, transduce_inplace
 from ddmm.models._validation import as_finite_array, check_positive
 
 __all__ = [
@@ -86,6 +86,9 @@ __all__ = [
     "type_label",
     "normalize_type",
     "stage_constants",
+    "bias_multiplier",
+    "tonic_current",
+    "initial_phase",
 ]
 
 #: The paper's three afferent types (eqs 1-3).
@@ -207,6 +210,42 @@ class CurrentParams:
     opponent_saii : float
         Ours: how much stretch against SA-II's preferred direction lowers its
         drive (dimensionless, 0: attenuated shear only).
+    normal_saii : float
+        Ours: weight of the normal force F_Z in SA-II's drive (dimensionless,
+        0: stretch only): the drive becomes ``x + normal_saii * F_Z``, so
+        SA-II respond to pressing as well as to stretch (docs/references.md
+        row 24: every nail-border SA-II responded to a 4 N normal force).
+    bias_cv_saii : float
+        Ours: spread of SA-II's resting discharge across units
+        (dimensionless, 0: every unit gets ``bias_saii``).  Each afferent's
+        tonic current is ``bias_saii * m`` with the lognormal multiplier
+        ``m = exp(s z - s^2 / 2)``, ``s^2 = log(1 + bias_cv_saii^2)``, and
+        ``z`` the standard normal keyed by the afferent's id alone
+        (`bias_multiplier`): a property of the unit, the same in every run,
+        seed, trial and engine.
+    phase_saii : float
+        Ours: spread of SA-II neurons' start phases over their tonic cycle
+        (dimensionless, in [0, 1]; 0: every neuron at rest, so tonic units
+        start in step).  The initial state is ``v = c``,
+        ``u = u_rest + phase_saii * U * d`` with ``U`` uniform in [0, 1) from
+        a draw keyed by (seed, condition, trial, afferent) (`initial_phase`);
+        noise-free runs (no key) start at rest.
+    dynamic_sai : float
+        Ours: depth of SA-I's dynamic response on the *current*
+        (dimensionless, 0: none): ``I <- max(I + dynamic_sai (I - J) - fall_sai J, 0)``
+        with ``J`` a first-order low-pass of the current (time constant
+        ``tau_dynamic_sai_s``), after the transducer and the current's
+        low-pass.  Being after the transducer, the overshoot in fast loading
+        and its decay through a hold are fractions of the current at every
+        force (the force-level ``adapt_sai`` is squashed by the log
+        compression and the bound at high forces).
+    fall_sai : float
+        Ours: SA-I's lasting adaptation on the current (dimensionless, in
+        [0, 1); 0: none): ``fall_sai * J`` is subtracted as well, so a held
+        current settles at ``(1 - fall_sai)`` of its value with time
+        constant ``tau_dynamic_sai_s``, a fraction at every force.
+    tau_dynamic_sai_s : float
+        Ours: time constant of that low-pass in s.
     i_max_sai, i_max_rai, i_max_raii, i_max_saii : float or None
         Ours: bound of the saturating transducer in mV/ms,
         ``I = i_max * tanh(d / i_max)``; None: no bound.
@@ -254,6 +293,12 @@ class CurrentParams:
     bias_saii: float = 0.0
     cutoff_saii_hz: float = 20.0
     opponent_saii: float = 0.0
+    normal_saii: float = 0.0
+    bias_cv_saii: float = 0.0
+    phase_saii: float = 0.0
+    dynamic_sai: float = 0.0
+    fall_sai: float = 0.0
+    tau_dynamic_sai_s: float = 1.0
     i_max_sai: float | None = None
     i_max_rai: float | None = None
     i_max_raii: float | None = None
@@ -271,7 +316,7 @@ class CurrentParams:
 
     def __post_init__(self):
         for name in ("g_sai", "g_rai", "g_raii", "g_saii", "cutoff_hz", "cutoff_saii_hz", "tau_adapt_sai_s",
-                     "tau_adapt_rai_s"):
+                     "tau_adapt_rai_s", "tau_dynamic_sai_s"):
             check_positive(getattr(self, name), name)
         _optional_positive(self, ("i_sat", "i_sat_sai", "i_sat_rai", "i_sat_raii", "i_max_sai", "i_max_rai",
                                   "i_max_raii", "i_max_saii"), "mV/ms")
@@ -283,8 +328,14 @@ class CurrentParams:
                 continue
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 8:
                 raise ValueError(f"{name} must be an int in [1, 8], got {value!r}")
-        for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii", "excite_cv_sai",
-                     "excite_cv_rai", "excite_cv_raii", "excite_cv_saii"):
+        if not self.fall_sai < 1.0:
+            raise ValueError(f"fall_sai must be a number in [0, 1), got {self.fall_sai!r}")
+        if isinstance(self.phase_saii, bool) or not isinstance(self.phase_saii, (int, float)) \
+                or not 0.0 <= self.phase_saii <= 1.0:
+            raise ValueError(f"phase_saii must be a number in [0, 1], got {self.phase_saii!r}")
+        for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii", "normal_saii",
+                     "bias_cv_saii", "dynamic_sai", "fall_sai", "excite_cv_sai", "excite_cv_rai", "excite_cv_raii",
+                     "excite_cv_saii"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -329,7 +380,10 @@ class CurrentParams:
                             self._own("bias", afferent_type, default=0.0), self._own("tau", afferent_type, "_s"),
                             self._own("threshold", afferent_type, default=0.0),
                             self._own("highpass", afferent_type, "_hz"),
-                            float(self._own("negative_weight", afferent_type, default=1.0)))
+                            float(self._own("negative_weight", afferent_type, default=1.0)),
+                            self._own("dynamic", afferent_type, default=0.0),
+                            self._own("tau_dynamic", afferent_type, "_s", 1.0),
+                            self._own("bias_cv", afferent_type, default=0.0), self._own("fall", afferent_type, default=0.0))
 
 
 @dataclass(frozen=True)
@@ -362,6 +416,13 @@ class CurrentStage:
     negative_weight : float
         Weight of the derivative's negative half-wave when it is rectified
         (1.0: the absolute value; dimensionless).
+    dynamic, tau_dynamic_s : float
+        Depth (dimensionless) and time constant (s) of the current-level
+        dynamic response (SA-I's ``dynamic_sai``).
+    bias_cv : float
+        Spread of the tonic current across units (SA-II's ``bias_cv_saii``).
+    fall : float
+        Lasting adaptation of the current (SA-I's ``fall_sai``).
     """
 
     afferent_type: str
@@ -378,6 +439,10 @@ class CurrentStage:
     threshold: float = 0.0
     highpass_hz: float | None = None
     negative_weight: float = 1.0
+    dynamic: float = 0.0
+    tau_dynamic_s: float = 1.0
+    bias_cv: float = 0.0
+    fall: float = 0.0
 
     @property
     def signed(self) -> bool:
@@ -427,6 +492,8 @@ class FilterState:
         Slow-adaptation low-pass of the filtered deviation (SA-I), in newtons.
     smooth : ndarray, shape (n_afferents,) or None
         The current's low-pass state in mV/ms (before the bias).
+    dyn : ndarray, shape (n_afferents,) or None
+        The dynamic response's low-pass of the current in mV/ms (SA-I).
     """
 
     zi: np.ndarray
@@ -435,6 +502,7 @@ class FilterState:
     y2: np.ndarray
     slow: np.ndarray | None = None
     smooth: np.ndarray | None = None
+    dyn: np.ndarray | None = None
 
 
 def lowpass_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
@@ -518,7 +586,7 @@ def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams(),
     sos = _stage_sos(params.stage(afferent_type), fs)
     zeros = np.zeros_like(f0)
     return FilterState(zi=np.zeros((sos.shape[0], 2, f0.size)), offset=f0, y1=zeros, y2=zeros.copy(),
-                       slow=zeros.copy(), smooth=zeros.copy())
+                       slow=zeros.copy(), smooth=zeros.copy(), dyn=zeros.copy())
 
 
 def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=None):
@@ -605,7 +673,8 @@ def afferent_current(
     return current_core(f_a, fs, afferent_type, params, state, scale)
 
 
-def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals=None, noise_cv=None, excite=None):
+def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals=None, noise_cv=None, excite=None,
+                 afferent_id=None):
     """`afferent_current` without validation (the hot path of `simulate`).
 
     ``normals`` (shape (n_afferents, n_samples), standard normal draws) and
@@ -617,6 +686,8 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     encoder.  ``excite`` (per afferent, dimensionless; `excitability`)
     multiplies the trial's current after the log compression and before
     the bound ``i_max`` (`transduce_inplace`).
+    encoder.  ``afferent_id`` (int array) keys the per-unit spread of the
+    tonic current (`bias_multiplier`); None: no spread.
     """
     fs = float(fs)
     st, sos, alpha_adapt, alpha_smooth = stage_constants(params, afferent_type, fs)
@@ -639,9 +710,59 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     current = transduce_inplace(drive, st, excite)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
     if st.tau_s is not None:
         current = smooth_kernel(current, smooth, alpha_smooth)
+    dyn = np.zeros(m) if state.dyn is None else state.dyn.copy()
+    if st.dynamic > 0.0 or st.fall > 0.0:
+        current = dynamic_kernel(current, dyn, _alpha(st.tau_dynamic_s, fs), float(st.dynamic), float(st.fall))
     if st.bias != 0.0:
-        current += st.bias
-    return current, FilterState(zi, state.offset, y1, y2, slow, smooth)
+        current += tonic_current(st, afferent_id, m)
+    return current, FilterState(zi, state.offset, y1, y2, slow, smooth, dyn)
+
+
+#: Key of the per-unit draws of the tonic current's spread (`bias_multiplier`): a fixed key, so the
+#: spread is a property of the unit, not of a run's seed.
+BIAS_KEY = 0x5A11_B1A5_0000_0001
+#: Tag mixed into a stream key for the initial phase (`initial_phase`): a stream of its own.
+PHASE_TAG = 0x9E37_79B9_7F4A_7C15
+
+
+def _alpha(tau_s: float, fs: float) -> float:
+    return float(-np.expm1(-1.0 / (fs * tau_s)))
+
+
+def bias_multiplier(bias_cv: float, afferent_id) -> np.ndarray:
+    """Per-unit lognormal multiplier of the tonic current, mean 1 and CV ``bias_cv``, keyed by afferent id.
+
+    Examples
+    --------
+    >>> m = bias_multiplier(0.4, np.arange(2000))
+    >>> bool(0.35 < m.std() < 0.45), bool(np.all(bias_multiplier(0.0, [3, 4]) == 1.0))
+    (True, True)
+    """
+    ids = np.ascontiguousarray(np.atleast_1d(afferent_id), dtype=np.int64)
+    if bias_cv == 0.0:
+        return np.ones(ids.size)
+    from ddmm.models.rng import normals
+
+    s2 = float(np.log1p(bias_cv * bias_cv))
+    return np.exp(np.sqrt(s2) * normals(BIAS_KEY, ids, 0, 1)[:, 0] - s2 / 2.0)
+
+
+def tonic_current(stage: CurrentStage, afferent_id, m: int):
+    """Each afferent's tonic current (mV/ms): ``stage.bias``, times `bias_multiplier` when spread."""
+    if stage.bias_cv == 0.0 or afferent_id is None:
+        return np.full(m, stage.bias)
+    return stage.bias * bias_multiplier(stage.bias_cv, afferent_id)
+
+
+def initial_phase(key: int, afferent_id) -> np.ndarray:
+    """Uniform draws in [0, 1) keyed by (stream ``key``, afferent id): the start phase of each tonic neuron."""
+    from math import erf, sqrt
+
+    from ddmm.models.rng import normals
+
+    ids = np.ascontiguousarray(np.atleast_1d(afferent_id), dtype=np.int64)
+    z = normals(np.uint64(key) ^ np.uint64(PHASE_TAG), ids, 0, 1)[:, 0]
+    return np.array([min(0.5 * (1.0 + erf(v / sqrt(2.0))), np.nextafter(1.0, 0.0)) for v in z])
 
 
 _NO_NORMALS = np.zeros((1, 0))

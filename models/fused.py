@@ -33,9 +33,9 @@ import math
 import numba as nb
 import numpy as np
 
-from ddmm.models._stage_kernels import filter_sections, receptor_noise_keyed, stage_tail, transduce_inplace
+from ddmm.models._stage_kernels import dynamic_step, filter_sections, receptor_noise_keyed, stage_tail, transduce_inplace
 from ddmm.models.attenuation import UNTUNED, profile_value
-from ddmm.models.currents import excitability, stage_constants
+from ddmm.models.currents import excitability, initial_phase, stage_constants, tonic_current
 from ddmm.models.engines import NeuronState, check_integration, check_stability, get_engine, run_checked, substeps_for
 from ddmm.models.engines.direct import BLOCK, METHOD_CODES, integrate_parts, integrate_range, part_bounds, spike_checks
 from ddmm.models.nap import get_profile, tip_radius
@@ -45,12 +45,13 @@ from ddmm.models.rng import normal_row
 __all__ = ["FusedPipeline", "mix_forces", "mixing_matrix"]
 
 # Rows of the per-afferent float table.
-_COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA = range(12)
+_COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA, _TONIC = range(13)
 # Rows of the per-group float and integer tables.
-_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _NEGATIVE = range(6)
+_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _NEGATIVE, _DYN, _ALPHA_DYN, _FALL = range(9)
 _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = range(9)
 # Rows of the state after the 2 * n_sections filter rows.
-_OFFSET, _Y1, _Y2, _SLOW, _SMOOTH = range(5)
+_OFFSET, _Y1, _Y2, _SLOW, _SMOOTH, _DYNC = range(6)
+_N_STATE = 6
 
 _RANGE = 512  # afferents per range of the front pass: its state and scratch fit in cache
 _SLICE = 1 << 17  # current elements per time slice of `FusedPipeline.currents`
@@ -69,7 +70,7 @@ def _shear(fx, fy, two_fth):
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value, f_th,
-                  opponent, af, cached):
+                  opponent, normal, af, cached):
     """The drive (newtons) of a group that feels one force, in passes: the profile AF where needed
     (`attenuation.profile_value`), then F_A = AF F_Z under the no-shear reading, or SA-II's stretch
     (`stretch_drive`).  As one loop, the profile's branches kept the whole body scalar, 3-4x slower.
@@ -91,6 +92,9 @@ def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_r
     if stretch:
         for j in range(f.size):
             f[j] = mag * (f[j] - opponent * (1.0 - f[j]))
+        if normal != 0.0:  # SA-II's normal-force drive (`stretch_drive`)
+            for j in range(f.size):
+                f[j] = f[j] + normal * fz
     elif smooth_reading:
         for j in range(f.size):
             f[j] = (((f[j] - 1.0) * w) + 1.0) * fz
@@ -110,7 +114,7 @@ def mixing_matrix(indptr, indices, coeff, n_sites: int) -> np.ndarray:
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_reading, outside_value, f_th, opponent,
-                 mags, wts):
+                 normal, mags, wts):
     """`_shared_drive` for afferents that each feel their own force ``local`` (3, n_afferents), in passes:
     shear magnitude and weight, the profile where needed, then the drive (the same arithmetic)."""
     for j in range(lo, hi):
@@ -129,6 +133,9 @@ def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_readin
     if stretch:
         for j in range(lo, hi):
             f[j] = mags[j] * (f[j] - opponent * (1.0 - f[j]))
+        if normal != 0.0:
+            for j in range(lo, hi):
+                f[j] = f[j] + normal * local[2, j]
     elif not tuned:
         for j in range(lo, hi):
             f[j] = local[2, j]
@@ -171,7 +178,7 @@ def mix_forces(forces, weights):
 
 @nb.njit(cache=True, nogil=True)
 def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, grp_f, grp_i,
-           sos, fs, smooth_reading, outside_value, f_th, opponent, out):
+           sos, fs, smooth_reading, outside_value, f_th, opponent, normal, out):
     """Force to linear drive into ``out`` (n, n_afferents); ``state`` in place (`_front_range` on every afferent).
 
     Afferents go in ranges of `_RANGE`, whose state and scratch stay in
@@ -181,25 +188,25 @@ def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, s
     m = aff_f.shape[1]
     for a0 in range(0, m, _RANGE):
         _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f,
-                     grp_f, grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, a0,
+                     grp_f, grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, normal, out, a0,
                      min(m, a0 + _RANGE))
     return out
 
 
 @nb.njit(cache=True, nogil=True, parallel=True)
 def _front_parts(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, grp_f,
-                 grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, bounds):
+                 grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, normal, out, bounds):
     """`_front` with the afferent ranges ``bounds[p]..bounds[p+1]`` in parallel (afferents are independent)."""
     for p in nb.prange(bounds.size - 1):
         _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f,
-                     grp_f, grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, bounds[p],
+                     grp_f, grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, normal, out, bounds[p],
                      bounds[p + 1])
     return out
 
 
 @nb.njit(cache=True, nogil=True)
 def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, grp_f,
-                 grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, out, a0, a1):
+                 grp_i, sos, fs, smooth_reading, outside_value, f_th, opponent, normal, out, a0, a1):
     """Force to linear drive of the afferents ``a0..a1`` into ``out`` (n, n_afferents); their ``state`` in place.
 
     ``forces`` (n, 3) is felt by every afferent, or with ``mixed`` each
@@ -229,14 +236,14 @@ def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, st
             tuned, stretch = grp_i[_TUNED_G, g] != 0, grp_i[_SIGNED, g] != 0
             if mixed:
                 _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_reading, outside_value,
-                             f_th, opponent, mags, wts)
+                             f_th, opponent, normal, mags, wts)
             elif not tuned and not stretch:
                 f[lo:hi] = fz  # untuned pressure afferents: F_A = F_Z
             else:
                 profiled = tuned and mag > 0.0 and (smooth_reading or stretch or mag > f_th)
                 cached = profiled and ux == af_ux[g] and uy == af_uy[g]
                 _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value,
-                              f_th, opponent, af, cached)
+                              f_th, opponent, normal, af, cached)
                 if profiled:
                     af_ux[g], af_uy[g] = ux, uy
             if i == 0 and not started and grp_i[_PLAIN, g] == 0:
@@ -259,7 +266,7 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i
     Additive noise is drawn for the afferents ``sigma_idx`` (those with
     sigma > 0) only: adding 0 * xi would leave every other current as it is.
     """
-    smooth = state[rows + _SMOOTH]
+    smooth, dync = state[rows + _SMOOTH], state[rows + _DYNC]
     lowest = np.inf
     sub_ids = ids[sigma_idx]
     words, xi = np.empty(sigma_idx.size, np.uint64), np.empty(sigma_idx.size)
@@ -272,9 +279,15 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i
                 for j in range(hi - lo):
                     c[j] = c[j] + alpha * (x[j] - c[j])  # `smooth_kernel`
                     x[j] = c[j]
-            if bias != 0.0:
+            depth, fall = grp_f[_DYN, g], grp_f[_FALL, g]
+            if depth > 0.0 or fall > 0.0:
+                c, alpha = dync[lo:hi], grp_f[_ALPHA_DYN, g]
                 for j in range(hi - lo):
-                    x[j] = x[j] + bias
+                    x[j], c[j] = dynamic_step(x[j], c[j], alpha, depth, fall)
+            if bias != 0.0:
+                tonic = aff_f[_TONIC, lo:hi]
+                for j in range(hi - lo):
+                    x[j] = x[j] + tonic[j]
         if additive and sigma_idx.size:
             normal_row(key, sub_ids, 0, sub_ids.size, sample0 + i, words, xi)
             for k in range(sigma_idx.size):
@@ -350,7 +363,8 @@ class FusedPipeline:
                                                 dtype=np.int64)
         self.n_afferents, self.fs, self.f_th = afferent_type.size, float(fs), float(f_th)
         self.smooth_reading, self.outside_value = no_shear == "smooth", 1.0 if no_shear == "pass" else 0.0
-        self.opponent = float(params.opponent_saii)
+        self.opponent, self.normal = float(params.opponent_saii), float(params.normal_saii)
+        self.phase_saii = float(params.phase_saii)
         change = (afferent_type[1:] != afferent_type[:-1]) | ((nap[1:] == UNTUNED) != (nap[:-1] == UNTUNED))
         bounds = np.flatnonzero(np.r_[True, change, True])  # runs of one type, tuned or not
         spans = list(zip(bounds[:-1], bounds[1:]))
@@ -378,7 +392,7 @@ class FusedPipeline:
 
     def _afferent_tables(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, spans, consts):
         n = self.n_afferents
-        aff_f = np.zeros((12, n))
+        aff_f = np.zeros((13, n))
         tuned = nap != UNTUNED
         rad = np.deg2rad(np.asarray(theta_t, dtype=float))
         aff_f[_COS], aff_f[_SIN], aff_f[_K] = np.cos(rad), np.sin(rad), np.asarray(k, dtype=float)
@@ -390,18 +404,20 @@ class FusedPipeline:
         scale = np.asarray(scale, dtype=float)
         for (a, b), (stage, *_) in zip(spans, consts):
             aff_f[_GAIN, a:b] = stage.gain * scale[a:b]  # as `current_core`
+            aff_f[_TONIC, a:b] = tonic_current(stage, self.afferent_id[a:b], b - a)  # as `current_core`
         aff_f[_CV] = noise_cv / np.sqrt(1000.0 / self.fs)  # as `current_core` and `_receptor_noise`
         aff_f[_SIGMA] = noise_sigma / np.sqrt(1000.0 / self.fs)  # as `noise_current`
         return aff_f
 
     def _group_tables(self, spans, consts, noise_cv, tuned):
         n_groups, n_sec = len(spans), max([sos.shape[0] for _, sos, _, _ in consts] + [1])
-        grp_f, grp_i = np.zeros((6, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
+        grp_f, grp_i = np.zeros((9, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
         sos_all = np.zeros((n_groups, n_sec, 6))
         for g, ((a, b), (st, sos, alpha_adapt, alpha_smooth)) in enumerate(zip(spans, consts)):
             sos_all[g, :sos.shape[0]] = sos
             plain = st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
-            grp_f[:, g] = [st.adapt, alpha_adapt, st.threshold, alpha_smooth, st.bias, st.negative_weight]
+            grp_f[:, g] = [st.adapt, alpha_adapt, st.threshold, alpha_smooth, st.bias, st.negative_weight, st.dynamic,
+                           float(-np.expm1(-1.0 / (self.fs * st.tau_dynamic_s))), st.fall]  # `currents._alpha`
             grp_i[:, g] = [sos.shape[0], st.derivative, st.signed, plain, np.any(noise_cv[a:b] > 0),
                            st.tau_s is not None, tuned[a], a, b]
         return grp_f, grp_i, sos_all
@@ -418,7 +434,7 @@ class FusedPipeline:
         started = sample0 > 0
         args = self._neuron_args(dt, method)
         if neuron is None:
-            v, u = (np.array(x, dtype=float) for x in resting_state(args[5]))
+            v, u = self.initial_neuron(key, args[5], args[7], args[6])
         else:
             v, u = neuron.v.copy(), neuron.u.copy()
         if not get_engine(engine).fused:  # the pipeline's currents need no second check at the seam
@@ -434,6 +450,19 @@ class FusedPipeline:
             check_integration(afferent, step, v, u, current, method, dt)
         return afferent, step, NeuronState(v, u)
 
+    def initial_neuron(self, key, b, d, c):
+        """Neuron state (v, u) before the first sample: at rest, or with ``phase_saii`` and a stream ``key``
+        each SA-II at its own phase (`ddmm.models.currents.initial_phase`): ``v = c``,
+        ``u = u_rest + phase_saii U d``."""
+        v, u = (np.array(x, dtype=float) for x in resting_state(b))
+        tonic = self.afferent_type == "SAII"
+        if self.phase_saii > 0.0 and key is not None and tonic.any():
+            cols = np.flatnonzero(tonic)
+            v[cols] = np.asarray(c, dtype=float)[cols] if np.ndim(c) else c
+            spread = self.phase_saii * initial_phase(key, self.afferent_id[cols])
+            u[cols] = u[cols] + spread * (np.asarray(d)[cols] if np.ndim(d) else d)
+        return v, u
+
     def _neuron_args(self, dt, method):
         """The direct engine's arguments for (dt, method), cached (as `ddmm.models.engines.direct.run_direct` computes them)."""
         key = (float(dt), method)
@@ -445,8 +474,8 @@ class FusedPipeline:
         return self._neuron_cache[key]
 
     def new_state(self) -> np.ndarray:
-        """Filter, offset, difference, adaptation and smoothing state at rest, shape (n_rows, n_afferents)."""
-        return np.zeros((self.rows + 5, self.n_afferents))
+        """Filter, offset, difference, adaptation, smoothing and dynamic-response state at rest, shape (n_rows, n_afferents)."""
+        return np.zeros((self.rows + _N_STATE, self.n_afferents))
 
     def _drive(self, forces, state, started, sample0, key, bounds=None, out=None):
         noisy, mixed = key is not None, self.mixing is not None
@@ -456,7 +485,7 @@ class FusedPipeline:
         args = (_NO_FORCES if mixed else forces, forces if mixed else _NO_SITES, self.mixing if mixed else _NO_WEIGHTS,
                 mixed, np.uint64(key or 0), noisy, self.afferent_id, int(sample0), state, started, self.aff_f,
                 self.grp_f, self.grp_i, self.sos, self.fs, self.smooth_reading, self.outside_value,
-                self.f_th, self.opponent, np.empty((forces.shape[0], self.n_afferents)) if out is None else out)
+                self.f_th, self.opponent, self.normal, np.empty((forces.shape[0], self.n_afferents)) if out is None else out)
         # The parallel kernel is called from here, never from a cached kernel
         # (numba's cache does not track a cached caller's parallel callee).
         drive = _front(*args) if bounds is None or bounds.size <= 2 else _front_parts(*args, bounds)

@@ -82,7 +82,7 @@ def compute_currents(
     stretch = np.flatnonzero(types == "SAII")
     if stretch.size:  # SA-II: the attenuated shear (skin stretch), not the normal force
         raw = profile_factor(fx, fy, theta[stretch], profile, np.broadcast_to(k, theta.shape)[stretch])
-        drive[:, stretch] = stretch_drive(fx, fy, raw, current_params.opponent_saii)
+        drive[:, stretch] = stretch_drive(fx, fy, raw, current_params.opponent_saii, fz, current_params.normal_saii)
     current = np.empty_like(drive)
     for kind in AFFERENT_TYPES:
         cols = np.flatnonzero(types == kind)

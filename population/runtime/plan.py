@@ -31,7 +31,7 @@ import numpy as np
 
 from ddmm.models._validation import check_choice
 from ddmm.models.attenuation import F_TH, UNTUNED
-from ddmm.models.currents import AFFERENT_TYPES, normalize_type
+from ddmm.models.currents import AFFERENT_TYPES, bias_multiplier, normalize_type
 from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
 
 __all__ = ["RECORD_CHOICES", "ConditionPlan", "Plan", "af_threshold", "make_plan"]
@@ -170,6 +170,9 @@ def _unit_keys(pop, sel, tuned, scale, local):
     theta = np.where(tuned, pop.theta_t[sel], 0.0)
     k = np.where(tuned, pop.k[sel], 0.0)
     columns = [type_code, nap_code, theta, k, scale]
+    if pop.current.bias_cv_saii > 0.0:  # each SA-II's own tonic current (`bias_multiplier`)
+        tonic = pop.afferent_type[sel] == "SAII"
+        columns.append(np.where(tonic, bias_multiplier(pop.current.bias_cv_saii, pop.afferent_id[sel]), 1.0))
     if local:  # each afferent feels its own force, a function of its type and position
         columns += [pop.x_mm[sel], pop.y_mm[sel]]
     return np.column_stack(columns)
@@ -186,7 +189,8 @@ def _quiet(pop, sel, scene, scale, af_stage, af_constant):
     blocked = (pop.nap[sel] != UNTUNED) & (not af_stage) & (af_constant == 0.0)
     pressed = (scale == 0.0) | blocked | (not np.any(scene.fz > 0.0))
     bias = pop.current.bias_saii
-    stretched = (scale == 0.0) | (scene.max_shear() == 0.0)
+    pressing = pop.current.normal_saii > 0.0 and bool(np.any(scene.fz != 0.0))  # `normal_saii`
+    stretched = (scale == 0.0) | ((scene.max_shear() == 0.0) and not pressing)
     return np.where(stretch, stretched & (bias == 0.0), pressed) & (pop.noise_sigma[sel] == 0.0)
 
 
@@ -209,6 +213,8 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
                    population_weight(pop, scene.contact)[sel])
     scale = pop.gain[sel] * (1.0 if weights is None else weights)
     noisy = (pop.noise_sigma[sel] > 0) | (pop.noise_cv[sel] > 0) | _excitable(pop, sel)
+    if pop.current.phase_saii > 0.0:  # a keyed start phase per (trial, afferent): no unit shares it
+        noisy |= pop.afferent_type[sel] == "SAII"
     if not enabled:
         return ConditionPlan(scene.name, scene.n_samples, True, af_constant, weights,
                              np.empty(0, np.int64), np.full(n, -1, np.int64))

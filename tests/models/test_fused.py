@@ -33,14 +33,14 @@ def forces(seed, n=400):
     return np.column_stack([shear * np.cos(angle), shear * np.sin(angle), fz])
 
 
-def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite=None):
+def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite=None, ids=None):
     """The stage-by-stage path: AF, F_A or stretch, each type's stage (with the trial ``excite``), additive noise."""
     fx, fy, fz = f.T
     drive = np.empty((f.shape[0], len(TYPES)))
     for j, (kind, nap) in enumerate(zip(TYPES, NAPS)):
         if kind == "SAII":
             af = profile_factor(fx, fy, theta[j], nap, k[j]) if nap != UNTUNED else np.ones((fx.size, 1))
-            drive[:, j] = stretch_drive(fx, fy, af, params.opponent_saii)[:, 0]
+            drive[:, j] = stretch_drive(fx, fy, af, params.opponent_saii, fz, params.normal_saii)[:, 0]
         elif nap == UNTUNED:
             drive[:, j] = fz
         else:
@@ -51,7 +51,8 @@ def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite=N
         cols = np.flatnonzero(np.array(TYPES) == kind)
         current[:, cols], _ = current_core(drive[:, cols], FS, kind, params, None, scale[cols],
                                            None if normals is None else normals[cols], cv[cols],
-                                           None if excite is None else excite[cols])
+                                           None if excite is None else excite[cols],
+                                           None if ids is None else ids[cols])
     if normals is not None and np.any(sigma > 0):
         current += (normals * (sigma / np.sqrt(1000.0 / FS))[:, None]).T
     return current
@@ -72,7 +73,7 @@ def test_fused_currents_equal_the_stage_by_stage_path(seed, no_shear, physio, no
     key = seed + 1 if noisy else None
     normals = keyed_normals(key, ids, 0, f.shape[0]) if noisy else None
     excite = excitability(key, ids, [params.excite_cv(t) for t in TYPES]) if noisy else None
-    expected = reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite)
+    expected = reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite, ids)
     plan = FusedPipeline(TYPES, NAPS, theta, k, scale, cv, sigma, params, FS, no_shear, 0.1, ids)
     state = plan.new_state()
     parts = [plan.currents(f[a:b], state, a > 0, a, key)
@@ -93,7 +94,7 @@ def test_fused_currents_in_time_slices_equal_the_stage_by_stage_path(monkeypatch
     f, ids = forces(5), np.arange(n)
     normals = keyed_normals(9, ids, 0, f.shape[0])
     excite = excitability(9, ids, [PHYSIO.excite_cv(t) for t in TYPES])
-    expected = reference(f, PHYSIO, "smooth", scale, cv, sigma, theta, k, normals, excite)
+    expected = reference(f, PHYSIO, "smooth", scale, cv, sigma, theta, k, normals, excite, ids)
     plan = FusedPipeline(TYPES, NAPS, theta, k, scale, cv, sigma, PHYSIO, FS, "smooth", 0.1, ids)
     np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False, 0, 9), expected)
 
@@ -119,7 +120,7 @@ def test_fused_currents_equal_the_reference_on_held_directions(no_shear):
     n = len(TYPES)
     theta, k, scale = rng.uniform(0, 360, n), rng.uniform(2.0, 5.0, n), np.ones(n)
     f = held_forces(3)
-    expected = reference(f, PHYSIO, no_shear, scale, np.zeros(n), np.zeros(n), theta, k, None)
+    expected = reference(f, PHYSIO, no_shear, scale, np.zeros(n), np.zeros(n), theta, k, None, ids=np.arange(n))
     plan = FusedPipeline(TYPES, NAPS, theta, k, scale, np.zeros(n), np.zeros(n), PHYSIO, FS, no_shear, 0.1)
     np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False), expected)
 

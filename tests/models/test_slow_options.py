@@ -1,0 +1,80 @@
+"""SA-II's normal drive, tonic spread and start phases; SA-I's dynamic response and lasting fall (CurrentParams)."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from ddmm.models.attenuation import stretch_drive
+from ddmm.models.currents import CurrentParams, bias_multiplier, current_core, initial_phase
+from ddmm.models.fused import FusedPipeline
+from ddmm.models.neuron import resting_state
+from ddmm.population import load_spec
+
+PHYSIO = load_spec("fingertip").current
+
+
+@pytest.mark.parametrize("field, value", [("normal_saii", -0.1), ("bias_cv_saii", float("nan")),
+                                          ("phase_saii", 1.5), ("phase_saii", True), ("dynamic_sai", -1.0),
+                                          ("fall_sai", 1.0), ("tau_dynamic_sai_s", 0.0)])
+def test_bad_values_are_refused_naming_the_option(field, value):
+    with pytest.raises(ValueError, match=field):
+        CurrentParams(**{field: value})
+
+
+def test_defaults_are_the_papers():
+    p = CurrentParams()
+    assert (p.normal_saii, p.bias_cv_saii, p.phase_saii, p.dynamic_sai, p.fall_sai) == (0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+def test_saii_drive_rises_with_normal_force():
+    fz = np.array([0.0, 1.0, 4.0])
+    zero = np.zeros(3)
+    assert stretch_drive(zero, zero, np.ones((3, 1)), 0.5).ravel().tolist() == [0.0, 0.0, 0.0]
+    assert stretch_drive(zero, zero, np.ones((3, 1)), 0.5, fz, 0.25).ravel().tolist() == [0.0, 0.25, 1.0]
+    plan = FusedPipeline(["SAII"], ["none"], [0.0], [0.0], [1.0], [0.0], [0.0], PHYSIO, 1000.0, "smooth", 0.1)
+    current = plan.currents(np.column_stack([zero, zero, fz]).repeat(200, axis=0), plan.new_state(), False)
+    assert current[399, 0] > current[199, 0] + 0.9 and current[-1, 0] > current[399, 0] + 2.5
+
+
+def test_tonic_current_is_spread_by_unit_and_the_same_in_every_run():
+    ids = np.arange(500)
+    m = bias_multiplier(0.25, ids)
+    assert np.array_equal(m, bias_multiplier(0.25, ids)) and 0.2 < m.std() < 0.3 and abs(m.mean() - 1.0) < 0.05
+    assert np.array_equal(bias_multiplier(0.25, ids[::-1]), m[::-1])  # keyed by id, not by position
+    plan = FusedPipeline(["SAII"] * 4, ["none"] * 4, [0.0] * 4, [0.0] * 4, [1.0] * 4, [0.0] * 4, [0.0] * 4, PHYSIO,
+                         1000.0, "smooth", 0.1, np.arange(4))
+    rest = plan.currents(np.zeros((5, 3)), plan.new_state(), False)[-1]
+    np.testing.assert_array_equal(rest, PHYSIO.bias_saii * bias_multiplier(PHYSIO.bias_cv_saii, np.arange(4)))
+    expected, _ = current_core(np.zeros((5, 4)), 1000.0, "SAII", PHYSIO, afferent_id=np.arange(4))
+    np.testing.assert_array_equal(expected[-1], rest)
+
+
+def test_start_phases_are_keyed_by_trial_and_afferent():
+    types = ["SAII"] * 3 + ["SAI"]
+    plan = FusedPipeline(types, ["none"] * 4, [0.0] * 4, [0.0] * 4, [1.0] * 4, [0.0] * 4, [0.5] * 4, PHYSIO, 1000.0,
+                         "smooth", 0.1)
+    v_rest, u_rest = resting_state(0.2)
+    v, u = plan.initial_neuron(7, np.full(4, 0.2), np.full(4, 8.0), np.full(4, -65.0))
+    assert np.all(v[:3] == -65.0) and v[3] == v_rest and u[3] == u_rest
+    np.testing.assert_array_equal(u[:3], u_rest + 8.0 * initial_phase(7, np.arange(3)))
+    assert len(set(u[:3].tolist())) == 3
+    assert not np.array_equal(plan.initial_neuron(8, np.full(4, 0.2), np.full(4, 8.0), np.full(4, -65.0))[1], u)
+    v0, u0 = plan.initial_neuron(None, np.full(4, 0.2), np.full(4, 8.0), np.full(4, -65.0))  # noise-free: at rest
+    assert np.all(v0 == v_rest) and np.all(u0 == u_rest)
+
+
+def _sai_current(params, force, n=3000, rise=100):
+    fz = np.r_[np.linspace(0.0, force, rise), np.full(n - rise, force)]
+    plan = FusedPipeline(["SAI"], ["none"], [0.0], [0.0], [1.0], [0.0], [0.0], params, 1000.0, "smooth", 0.1)
+    return plan.currents(np.column_stack([0 * fz, 0 * fz, fz]), plan.new_state(), False)[:, 0]
+
+
+@pytest.mark.parametrize("force", [0.5, 8.0])
+def test_sai_current_falls_by_a_fraction_through_a_hold_at_every_force(force):
+    off = _sai_current(replace(PHYSIO, dynamic_sai=0.0, fall_sai=0.0), force)
+    on = _sai_current(PHYSIO, force)
+    fall_off = 1.0 - off[-500:].mean() / off[100:600].mean()
+    fall_on = 1.0 - on[-500:].mean() / on[100:600].mean()
+    assert fall_on > fall_off + 0.1  # the lasting fall adds a tenth or more at 0.5 N and at 8 N alike
+    assert on[100:200].max() > off[100:200].max()  # and the overshoot in loading

@@ -1,0 +1,43 @@
+"""The slow-type protocols (`ddmm.population.analysis.physiology_slow`): registered, referenced, and measuring."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from ddmm.experiments.paper_values import PHYSIOLOGY_REFERENCE
+from ddmm.population import sample_population
+from ddmm.population.analysis import physiology, physiology_slow
+from ddmm.population.analysis.physiology import score_physiology
+
+
+@pytest.fixture(scope="module")
+def slow_pop():
+    pop = sample_population("fingertip", rng=0)
+    keep = np.r_[np.flatnonzero(pop.afferent_type == "SAI")[::3], np.flatnonzero(pop.afferent_type == "SAII")]
+    return pop.select(np.sort(keep))  # every SA-II: the synchrony of 36 random phases is small, of 12 not always
+
+
+def test_rows_are_registered_with_references_half_held_out():
+    names = list(physiology_slow.PROPERTIES)
+    assert set(names) <= set(physiology.PROPERTIES) and set(physiology_slow.PROTOCOLS) <= set(physiology.PROTOCOLS)
+    roles = [PHYSIOLOGY_REFERENCE[n].role for n in names]
+    assert roles.count("held out") * 2 >= len(roles)
+
+
+def _values(pop, names):
+    rows, _ = score_physiology(pop, PHYSIOLOGY_REFERENCE, properties=names, seed=0)
+    return {r["name"]: (r["value"], r["pass"]) for r in rows}
+
+
+def test_preset_passes_the_slow_rows(slow_pop):
+    values = _values(slow_pop, list(physiology_slow.PROPERTIES))
+    assert all(ok for _, ok in values.values()), values
+
+
+def test_without_the_options_the_slow_rows_fail(slow_pop):
+    """The paper-like SA-II (no normal drive, one bias, start at rest) and SA-I without the dynamic stage fail."""
+    off = replace(slow_pop.current, normal_saii=0.0, bias_cv_saii=0.0, phase_saii=0.0, dynamic_sai=0.0, fall_sai=0.0)
+    values = _values(replace(slow_pop, current=off), ["normal_coding_SAII", "rest_spread_SAII", "start_synchrony_SAII",
+                                                       "adaptation_8N_SAI"])
+    assert not any(ok for _, ok in values.values()), values
