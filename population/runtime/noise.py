@@ -17,6 +17,11 @@ length h = 1000/fs ms.  Two terms use it:
 * drive-proportional (receptor noise), ``I * cv * xi / sqrt(h)``, applied by
   the current stage before the current's low-pass: an undriven afferent
   stays silent.
+
+A third term is drawn once per trial, not per sample: the trial
+excitability (``excite_cv_<type>``, `ddmm.models.currents.excitability`),
+the draw of sample ``ddmm.models.currents.EXCITE_SAMPLE`` (2**32 - 1) under
+the same key.
 """
 
 from __future__ import annotations
