@@ -46,12 +46,14 @@ from ._pinned_digest import AFFERENTS, pinned_env
 
 #: Digests of the run under pinned dispatch (`_pinned_digest.run_digests`).  The spikes' are also
 #: what every host's own dispatch gave, on every instruction set tried; the currents' are not.
-#: Re-recorded on branch i20-phase for the FA-I phase-preserving drive of the presets; with the
-#: presets of a6ed2a8 the code there still gives the digests of before (41521a8f..., 19849, 24d8967e...).
+#: Re-recorded when the presets switched on the physiological mechanisms of docs/model.md ("What
+#: changed in the model": the half-wave FA-I drive, trial excitability, SA-II's normal drive and
+#: spread, SA-I's dynamic response, the refitted NAP mixes); each branch that added one showed that
+#: with the earlier presets the code still gives the earlier digests (41521a8f..., 19849, 24d8967e...).
 RECORDED = {
-    "spikes": "af2404dd31f9779fd8f28166611385431f05e6e8203d6087e9135afb3dda1073",
-    "n_spikes": 14365,
-    "currents": "7246968ee1fd749b37e05eaaa7ac0df2db0bdb8a27b5a2db8ef029c59e607c02",
+    "spikes": "81fadf155778da28fbfaa2dee90afb84a7edc063413ac013368c486b6c375430",
+    "n_spikes": 15031,
+    "currents": "e97eab2555dbdc6584b166e0d421b501762dc82c8a3bfc55b110b420124d610c",
 }
 #: Where they were recorded: the bits of libm and of numpy's baseline loops are the platform's.
 RECORDED_ON = "x86_64 Linux, glibc 2.36, numpy 2.3 (baseline SSE SSE2 SSE3)"
