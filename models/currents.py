@@ -30,7 +30,14 @@ which the physiological presets switch on (docs/model.md, "What changed in the m
 * **SA-II (Ruffini), a fourth type.**  Driven by skin stretch, from forces
   the attenuated *shear*: ``x = F_S * (AF - opponent_saii * (1 - AF))`` (so
   stretch against the preferred direction lowers the rate), low-passed at
-  ``cutoff_saii_hz``, on top of a tonic ``bias_saii`` current.
+  ``cutoff_saii_hz``, on top of a tonic ``bias_saii`` current.  Options:
+  ``normal_saii`` adds the normal force to the drive, ``bias_cv_saii``
+  spreads the tonic current across units (keyed by afferent id) and
+  ``phase_saii`` starts each neuron at its own keyed phase.
+* **SA-I dynamics on the current.**  ``dynamic_sai`` and ``fall_sai`` act
+  after the transducer: ``I + dynamic (I - J) - fall J`` with ``J`` a
+  low-pass of the current (``tau_dynamic_sai_s``): an overshoot in fast
+  loading and a fractional fall through a hold at every force.
 * **Saturating transducers.**  ``i_max_<type>`` bounds the current:
   ``I = i_max * tanh(d / i_max)`` for the linear drive ``d = g * x``, so
   rates stay physiological on fast ramps.  The older log compression

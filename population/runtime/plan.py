@@ -10,7 +10,7 @@ condition, what can be skipped without changing a single spike:
 * afferent types that were not requested;
 * afferents whose current is provably identically zero (no additive noise,
   and zero normal force, zero receptive-field weight, zero gain, or AF = 0;
-  for SA-II no bias and no shear): they stay at their resting fixed point
+  for SA-II no bias, no shear and, with ``normal_saii``, no normal force): they stay at their resting fixed point
   and never spike.  Drive-proportional noise (``noise_cv``) is zero with the
   drive, so it does not stop an afferent from being skipped; nor does the
   trial excitability (``excite_cv_<type>``), a factor on the current;
