@@ -1,9 +1,11 @@
 """Scorecard protocol ``fields``: receptive fields that grow with force, as human fields do.
 
 A point probe (a contact of 0.5 mm radius) presses at 0.4, 0.8 and 1.6 N
-(a 50 ms ramp, a 0.65 s hold) on a line of untuned, noise-free afferents of
-each type at 0-30 mm from its centre, with the population's current stage
-and receptive-field shape.  An afferent responds when it fires after the
+(a 50 ms ramp, a 0.65 s hold) on a line of untuned afferents of each type
+at 0-30 mm from its centre, with the population's current stage and
+receptive-field shape, free of noise and of trial-to-trial excitability
+(a field is a geometric property: with noise, the farthest responding
+afferent would move from trial to trial).  An afferent responds when it fires after the
 ramp starts; the field's radius at a force is the farthest responding
 afferent.  The statistic is the smallest ratio of radii from one force to
 the next doubling: above 1 when every doubling widens the field, 1 when the
@@ -13,6 +15,8 @@ response is the subject of the slowly adapting protocols.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -47,7 +51,8 @@ def field_radii(population, kind: str, context) -> np.ndarray:
     """Radius (mm) of the responding field of ``kind`` at each of `FIELD_FORCES_N` (0 where none responds)."""
     from ddmm.population.sampling import make_population
 
-    line = make_population([kind] * _DISTANCES_MM.size, x_mm=_DISTANCES_MM, current=population.current,
+    quiet = replace(population.current, **{f"excite_cv_{t.lower()}": 0.0 for t in ("SAI", "RAI", "RAII", "SAII")})
+    line = make_population([kind] * _DISTANCES_MM.size, x_mm=_DISTANCES_MM, current=quiet,
                            name=f"{population.name}_probe_line", receptive_field=population.receptive_field)
     ds = _run(line, [probe_scene(f) for f in FIELD_FORCES_N], context, record=("spikes",))
     radii = np.zeros(len(FIELD_FORCES_N))
