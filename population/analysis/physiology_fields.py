@@ -77,4 +77,4 @@ def _fields(population, context):
 
 
 RUNNERS = {"fields": _fields}
-load_extensions()  # when this module was imported before the scorecard's (see `load_extensions`)
+load_extensions()  # a no-op unless this module was imported before the scorecard (see `load_extensions`)

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.population.analysis import physiology as _core_physiology
+from ddmm.population.analysis import physiology as _core
 from ddmm.population.analysis.physiology import Property, _knots, _of, _rates
 
 __all__ = ["PROPERTIES", "PROTOCOLS", "RUNNERS", "hold_scene"]
@@ -133,4 +133,4 @@ def _slow_fast(population, context):
 
 RUNNERS = {"slow_rest": _slow_rest, "slow_normal": _slow_normal, "slow_fast": _slow_fast}
 
-_core_physiology.load_extensions()  # when this module was imported before the scorecard (see `load_extensions`)
+_core.load_extensions()  # a no-op unless this module was imported before the scorecard (see `load_extensions`)

@@ -97,5 +97,4 @@ def _variability(population, context):
 
 RUNNERS = {"variability": _variability}
 
-if PROTOCOLS[0] not in _core.PROTOCOLS:  # imported before `physiology`, which then skipped it
-    _core.load_extensions()
+_core.load_extensions()  # a no-op unless this module was imported before the scorecard (see `load_extensions`)

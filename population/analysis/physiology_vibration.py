@@ -164,4 +164,4 @@ def vibration_rate_sai(population, context):
 
 
 RUNNERS = {"phase_locking": _phase_locking}
-_ph.load_extensions()  # when this module was imported before the scorecard (see `load_extensions`)
+_ph.load_extensions()  # a no-op unless this module was imported before the scorecard (see `load_extensions`)
