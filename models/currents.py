@@ -27,6 +27,13 @@ which the physiological presets switch on (docs/model.md, "What changed in the m
   the attenuated *shear*: ``x = F_S * (AF - opponent_saii * (1 - AF))`` (so
   stretch against the preferred direction lowers the rate), low-passed at
   ``cutoff_saii_hz``, on top of a tonic ``bias_saii`` current.
+* **Shear magnitude in the pressure types' drive.**  ``shear_sai``,
+  ``shear_rai`` and ``shear_raii`` add a stretch-like term to F_A before the
+  type's filter, ``x = F_A + shear_<type> * F_S * (AF - opponent_shear * (1 - AF))``
+  (AF the profile's own, `attenuation.shear_drive`): tangential force along
+  the preferred direction raises the drive, against it lowers it, growing
+  with F_S (FA-I and FA-II see its derivatives during a tangential ramp).
+  The paper's F_A alone only attenuates: shear can never raise a rate.
 * **Saturating transducers.**  ``i_max_<type>`` bounds the current:
   ``I = i_max * tanh(d / i_max)`` for the linear drive ``d = g * x``, so
   rates stay physiological on fast ramps.  The older log compression
@@ -202,6 +209,14 @@ class CurrentParams:
     opponent_saii : float
         Ours: how much stretch against SA-II's preferred direction lowers its
         drive (dimensionless, 0: attenuated shear only).
+    shear_sai, shear_rai, shear_raii : float
+        Ours: gain of the shear-magnitude term added to the type's F_A
+        (dimensionless, N of drive per N of shear; 0: the paper's F_A, which
+        shear only attenuates), ``shear * F_S * (AF - opponent_shear (1 - AF))``
+        with AF the profile's own factor (docs/model.md, "What changed").
+    opponent_shear : float
+        Ours: how much shear against the preferred direction lowers the
+        pressure types' shear term (dimensionless, as ``opponent_saii``).
     i_max_sai, i_max_rai, i_max_raii, i_max_saii : float or None
         Ours: bound of the saturating transducer in mV/ms,
         ``I = i_max * tanh(d / i_max)``; None: no bound.
@@ -233,6 +248,10 @@ class CurrentParams:
     bias_saii: float = 0.0
     cutoff_saii_hz: float = 20.0
     opponent_saii: float = 0.0
+    shear_sai: float = 0.0
+    shear_rai: float = 0.0
+    shear_raii: float = 0.0
+    opponent_shear: float = 0.0
     i_max_sai: float | None = None
     i_max_rai: float | None = None
     i_max_raii: float | None = None
@@ -256,7 +275,8 @@ class CurrentParams:
                 continue
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 8:
                 raise ValueError(f"{name} must be an int in [1, 8], got {value!r}")
-        for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii"):
+        for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii", "shear_sai", "shear_rai",
+                     "shear_raii", "opponent_shear"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -290,7 +310,7 @@ class CurrentParams:
                             self.saturation(afferent_type), self._own("i_max", afferent_type),
                             self._own("bias", afferent_type, default=0.0), self._own("tau", afferent_type, "_s"),
                             self._own("threshold", afferent_type, default=0.0),
-                            self._own("highpass", afferent_type, "_hz"))
+                            self._own("highpass", afferent_type, "_hz"), self._own("shear", afferent_type, default=0.0))
 
 
 @dataclass(frozen=True)
@@ -320,6 +340,8 @@ class CurrentStage:
         Dead zone of the rectified drive (RA-I's velocity threshold, N/s).
     highpass_hz : float or None
         Cut-off of a 2nd-order high-pass in the filter cascade (RA-II), Hz.
+    shear : float
+        Gain of the shear-magnitude term added to F_A (dimensionless; 0: none).
     """
 
     afferent_type: str
@@ -335,6 +357,7 @@ class CurrentStage:
     tau_s: float | None = None
     threshold: float = 0.0
     highpass_hz: float | None = None
+    shear: float = 0.0
 
     @property
     def signed(self) -> bool:

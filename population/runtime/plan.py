@@ -5,11 +5,13 @@ condition, what can be skipped without changing a single spike:
 
 * the NAP/AF stage when no shear ever exceeds F_TH (AF is then 1 under
   ``no_shear="pass"`` and 0 under ``"block"``), or, under ``"smooth"`` and
-  for SA-II's stretch, when there is no shear at all;
+  for SA-II's stretch and the pressure types' shear-magnitude term, when
+  there is no shear at all;
 * spatial weighting when the scene has no contact geometry;
 * afferent types that were not requested;
 * afferents whose current is provably identically zero (no additive noise,
-  and zero normal force, zero receptive-field weight, zero gain, or AF = 0;
+  and zero normal force (or AF = 0) with no shear-magnitude term,
+  or zero receptive-field weight or gain;
   for SA-II no bias and no shear): they stay at their resting fixed point
   and never spike.  Drive-proportional noise (``noise_cv``) is zero with the
   drive, so it does not stop an afferent from being skipped;
@@ -182,10 +184,17 @@ def _quiet(pop, sel, scene, scale, af_stage, af_constant):
     """Afferents whose noise-free current is identically zero (they never leave rest)."""
     stretch = pop.afferent_type[sel] == "SAII"
     blocked = (pop.nap[sel] != UNTUNED) & (not af_stage) & (af_constant == 0.0)
-    pressed = (scale == 0.0) | blocked | (not np.any(scene.fz > 0.0))
+    sheared = _shear_gained(pop, sel) & (scene.max_shear() > 0.0)  # the shear-magnitude term drives them
+    pressed = (scale == 0.0) | ((blocked | (not np.any(scene.fz > 0.0))) & ~sheared)
     bias = pop.current.bias_saii
     stretched = (scale == 0.0) | (scene.max_shear() == 0.0)
     return np.where(stretch, stretched & (bias == 0.0), pressed) & (pop.noise_sigma[sel] == 0.0)
+
+
+def _shear_gained(pop, sel):
+    """Whether each afferent's drive has a shear-magnitude term (``CurrentParams.shear_<type>`` > 0)."""
+    gain = {t: pop.current.stage(t).shear if t != "SAII" else 0.0 for t in AFFERENT_TYPES}
+    return np.array([gain[t] > 0.0 for t in pop.afferent_type[sel]], dtype=bool)
 
 
 def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
@@ -209,7 +218,7 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
     member = np.where(quiet, -2, -1).astype(np.int64)
     units = np.empty(0, np.int64)
     if deterministic.size:
-        stretch = pop.afferent_type[sel[deterministic]] == "SAII"
+        stretch = (pop.afferent_type[sel[deterministic]] == "SAII") | _shear_gained(pop, sel[deterministic])
         tuned = (pop.nap[sel[deterministic]] != UNTUNED) & np.where(stretch, scene.max_shear() > 0.0, af_stage)
         keys = _unit_keys(pop, sel[deterministic], tuned, scale[deterministic], local)
         _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)

@@ -5,7 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ddmm.models.attenuation import UNTUNED, attenuated_force, attenuation_factor, profile_factor, stretch_drive
+from ddmm.models.attenuation import (UNTUNED, attenuated_force, attenuation_factor, profile_factor, shear_drive,
+                                     stretch_drive)
 from ddmm.models.currents import CurrentParams, current_core
 from ddmm.models.fused import FusedPipeline
 from ddmm.models.rng import normals as keyed_normals
@@ -42,6 +43,9 @@ def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals):
         else:
             drive[:, j] = attenuated_force(fz, attenuation_factor(fx, fy, theta[j], nap, k[j],
                                                                   no_shear=no_shear))[:, 0]
+        if kind != "SAII":  # the presets' shear-magnitude term (a no-op at the paper's defaults)
+            raw = profile_factor(fx, fy, theta[j], nap, k[j])
+            drive[:, [j]] = shear_drive(drive[:, [j]], fx, fy, raw, params.stage(kind).shear, params.opponent_shear)
     current = np.empty_like(drive)
     for kind in dict.fromkeys(TYPES):
         cols = np.flatnonzero(np.array(TYPES) == kind)
@@ -121,7 +125,9 @@ def test_fused_plan_needs_no_tuned_afferent():
     plan = FusedPipeline(["RAI", "RAI"], ["none", "none"], [0.0, 0.0], [3.0, 3.0], [1.0, 1.0], [0.0, 0.0], [0.0, 0.0],
                      PHYSIO, FS, "smooth", 0.1)
     f = forces(1)
-    expected, _ = current_core(np.column_stack([f[:, 2], f[:, 2]]), FS, "RAI", PHYSIO, None, np.ones(2))
+    drive = shear_drive(np.column_stack([f[:, 2], f[:, 2]]), f[:, 0], f[:, 1], np.ones((f.shape[0], 2)),
+                        PHYSIO.shear_rai, PHYSIO.opponent_shear)  # untuned: AF = 1, every direction
+    expected, _ = current_core(drive, FS, "RAI", PHYSIO, None, np.ones(2))
     np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False), expected)
 
 
