@@ -225,7 +225,7 @@ def stretch_drive(fx, fy, af, opponent: float = 0.0) -> np.ndarray:
 
 
 def shear_drive(f_a, fx, fy, af, gain: float, opponent: float = 0.0) -> np.ndarray:
-    """A pressure type's drive with its shear-magnitude term, ``F_A + gain * stretch_drive`` (N).
+    """A pressure type's drive with its shear-magnitude term, ``max(F_A + gain * stretch_drive, 0)`` (N).
 
     ``f_a`` is F_A (shape (n_samples, n_afferents)); ``af`` the profile's own
     AF on the shear direction (`profile_factor`, no threshold), ``gain`` the
@@ -236,13 +236,17 @@ def shear_drive(f_a, fx, fy, af, gain: float, opponent: float = 0.0) -> np.ndarr
 
     Examples
     --------
-    >>> shear_drive([[2.0, 2.0]], [0.0], [1.0], [[1.0, 0.2]], 1.0, opponent=0.5).tolist()
-    [[3.0, 1.8]]
+    >>> shear_drive([[2.0, 0.4]], [0.0], [1.0], [[1.0, 0.2]], 1.0, opponent=1.0).tolist()
+    [[3.0, 0.0]]
+
+    The floor keeps the drive a pressure: a negative drive would read as
+    force to the rectified FA stages.
     """
     f_a = np.asarray(f_a, dtype=float)
     if gain == 0.0:
         return f_a
-    return f_a + gain * stretch_drive(fx, fy, af, opponent)
+    x = f_a + gain * stretch_drive(fx, fy, af, opponent)
+    return np.where(x > 0.0, x, 0.0)  # floored: shear against the preferred direction silences, never pulls
 
 
 @nb.njit(cache=True, nogil=True, inline="always")

@@ -29,7 +29,7 @@ which the physiological presets switch on (docs/model.md, "What changed in the m
   ``cutoff_saii_hz``, on top of a tonic ``bias_saii`` current.
 * **Shear magnitude in the pressure types' drive.**  ``shear_sai``,
   ``shear_rai`` and ``shear_raii`` add a stretch-like term to F_A before the
-  type's filter, ``x = F_A + shear_<type> * F_S * (AF - opponent_shear * (1 - AF))``
+  type's filter, ``x = max(0, F_A + shear_<type> * F_S * (AF - opponent_shear * (1 - AF)))``
   (AF the profile's own, `attenuation.shear_drive`): tangential force along
   the preferred direction raises the drive, against it lowers it, growing
   with F_S (FA-I and FA-II see its derivatives during a tangential ramp).

@@ -77,7 +77,8 @@ def _sheared(p, fz, mag, w, tuned, smooth_reading, outside_value, f_th, shear_g,
         fa = (((p - 1.0) * w) + 1.0) * fz
     else:
         fa = (p if mag > f_th else outside_value) * fz
-    return fa + shear_g * (mag * (p - opp_s * (1.0 - p)))
+    x = fa + shear_g * (mag * (p - opp_s * (1.0 - p)))
+    return x if x > 0.0 else 0.0  # `shear_drive`'s floor
 
 
 @nb.njit(cache=True, nogil=True, inline="always")

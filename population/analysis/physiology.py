@@ -507,5 +507,5 @@ def summarise_scorecard(rows) -> str:
 
 
 # Protocol modules beyond the core battery, each adding its rows (see `_extend`).
-for _name in ():
+for _name in ("physiology_shear",):
     _extend(_name)

@@ -11,7 +11,7 @@ every afferent a scene along its own theta_T.  SA types are read in the
 shear hold (1.6-2.5 s), FA types during the tangential ramp (1.0 s to its
 end + 0.1 s).
 
-``shear_variant``: the same at 4 N normal with the tangential ramp at 1 N/s
+``shear_variant``: the same at 4 N normal with the tangential ramp at 4 N/s
 (no gain was set on it: a prediction).
 """
 
@@ -37,22 +37,20 @@ def _p(name, kind, protocol, statistic, unit="1"):
 
 
 PROPERTIES = dict([
-    _p("shear_pref_SAI", "SAI", "shear", "mean rate, 1 N shear preferred / no shear (2 N normal)"),
-    _p("shear_opp_SAI", "SAI", "shear", "mean rate, 1 N shear opposite / no shear (2 N normal)"),
-    _p("shear_growth_SAI", "SAI", "shear", "smallest rise of the mean rate, 0 -> 0.25 -> 0.5 -> 1 N preferred", "1/s"),
-    _p("shear_fall_SAI", "SAI", "shear", "largest change of the mean rate, 0 -> 0.25 -> 0.5 -> 1 N opposite", "1/s"),
+    _p("shear_pref_SAI", "SAI", "shear", "median rate, 1 N shear preferred / no shear (2 N normal)"),
+    _p("shear_opp_SAI", "SAI", "shear", "median rate, 1 N shear opposite / no shear (2 N normal)"),
+    _p("shear_growth_SAI", "SAI", "shear", "smallest rise of the median rate, 0 -> 0.25 -> 0.5 -> 1 N preferred", "1/s"),
+    _p("shear_fall_SAI", "SAI", "shear", "largest change of the median rate, 0 -> 0.25 -> 0.5 -> 1 N opposite", "1/s"),
     _p("shear_growth_RAI", "RAI", "shear", "smallest rise of the mean ramp count, 0 -> 0.25 -> 0.5 -> 1 N preferred"),
     _p("shear_dir_RAI", "RAI", "shear", "mean ramp count, 1 N preferred / opposite"),
     _p("shear_ramp_RAI", "RAI", "shear", "fraction firing late in a 2 N/s tangential ramp (0.4-1 N, preferred)"),
-    _p("shear_growth_RAII", "RAII", "shear",
-       "smallest rise of the mean ramp count, 0 -> 0.25 -> 0.5 -> 1 N preferred"),
     _p("shear_dir_RAII", "RAII", "shear", "mean ramp count, 1 N preferred / opposite"),
-    _p("shear_growth_SAII", "SAII", "shear", "smallest rise of the mean rate, 0 -> 0.25 -> 0.5 -> 1 N preferred",
+    _p("shear_growth_SAII", "SAII", "shear", "smallest rise of the median rate, 0 -> 0.25 -> 0.5 -> 1 N preferred",
        "1/s"),
     _p("shear_variant_SAI", "SAI", "shear_variant",
-       "4 N normal, 1 N/s shear: smallest rise of the mean rate (preferred), minus largest change (opposite)", "1/s"),
+       "4 N normal, 4 N/s shear: smallest rise of the median rate (preferred), minus largest change (opposite)", "1/s"),
     _p("shear_variant_RAI", "RAI", "shear_variant",
-       "4 N normal, 1 N/s shear: smallest rise of the mean ramp count, 0 -> 0.25 -> 0.5 -> 1 N preferred"),
+       "4 N normal, 4 N/s shear: smallest rise of the mean ramp count, 0 -> 0.25 -> 0.5 -> 1 N preferred"),
 ])
 PROTOCOLS = ("shear", "shear_variant")
 
@@ -84,9 +82,10 @@ def _measure(population, context, normal_n, rate_n_s):
     return ds, sa, fa, late
 
 
-def _curves(values, mask):
-    """Population means at 0 then the magnitudes, preferred and opposite."""
-    mean = values[:, mask].mean(axis=1)
+def _curves(values, mask, stat=np.mean):
+    """Population statistic (mean; SA rates: median, the typical afferent's) at 0 then the magnitudes,
+    preferred and opposite."""
+    mean = stat(values[:, mask], axis=1)
     n = len(MAGNITUDES_N)
     return np.r_[mean[0], mean[1:1 + n]], np.r_[mean[0], mean[1 + n:]]
 
@@ -99,26 +98,27 @@ def _shear(population, context) -> tuple:
     ds, sa, fa, late = _measure(population, context, 2.0, 2.0)
     out, data = {}, {"sa_rate": sa, "fa_count": fa, "type": ds.afferent_type.values}
     if _of(ds, "SAI").any():
-        pref, opp = _curves(sa, _of(ds, "SAI"))
+        pref, opp = _curves(sa, _of(ds, "SAI"), np.median)
         out.update(shear_pref_SAI=_ratio(pref[-1], pref[0]), shear_opp_SAI=_ratio(opp[-1], opp[0]),
                    shear_growth_SAI=float(np.diff(pref).min()), shear_fall_SAI=float(np.diff(opp).max()))
     for kind in ("RAI", "RAII"):
         if _of(ds, kind).any():
             pref, opp = _curves(fa, _of(ds, kind))
-            out[f"shear_growth_{kind}"] = float(np.diff(pref).min())
+            if kind == "RAI":  # FA-II code the ramp's corners (transients), not its end value
+                out[f"shear_growth_{kind}"] = float(np.diff(pref).min())
             out[f"shear_dir_{kind}"] = _ratio(pref[-1], opp[-1])
     if _of(ds, "RAI").any():
         out["shear_ramp_RAI"] = float(np.mean(late[_of(ds, "RAI")] > 0))
     if _of(ds, "SAII").any():
-        out["shear_growth_SAII"] = float(np.diff(_curves(sa, _of(ds, "SAII"))[0]).min())
+        out["shear_growth_SAII"] = float(np.diff(_curves(sa, _of(ds, "SAII"), np.median)[0]).min())
     return out, data
 
 
 def _shear_variant(population, context) -> tuple:
-    ds, sa, fa, _ = _measure(population, context, 4.0, 1.0)
+    ds, sa, fa, _ = _measure(population, context, 4.0, 4.0)
     out = {}
     if _of(ds, "SAI").any():
-        pref, opp = _curves(sa, _of(ds, "SAI"))
+        pref, opp = _curves(sa, _of(ds, "SAI"), np.median)
         out["shear_variant_SAI"] = float(min(np.diff(pref).min(), -np.diff(opp).max()))
     if _of(ds, "RAI").any():
         out["shear_variant_RAI"] = float(np.diff(_curves(fa, _of(ds, "RAI"))[0]).min())

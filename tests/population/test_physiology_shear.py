@@ -1,0 +1,32 @@
+"""The shear protocol module (`ddmm.population.analysis.physiology_shear`) in the scorecard."""
+
+from dataclasses import replace
+
+import pytest
+
+from ddmm.experiments.paper_values import PHYSIOLOGY_REFERENCE
+from ddmm.population import sample_population
+from ddmm.population.analysis import physiology, physiology_shear
+
+NAMES = list(physiology_shear.PROPERTIES)
+
+
+def test_rows_are_registered_with_references_half_held_out():
+    assert set(NAMES) <= set(physiology.PROPERTIES)
+    assert set(physiology_shear.PROTOCOLS) <= set(physiology.PROTOCOLS)
+    roles = [PHYSIOLOGY_REFERENCE[n].role for n in NAMES]
+    assert roles.count("held out") >= len(roles) / 2
+
+
+@pytest.fixture(scope="module")
+def fingertip():
+    return sample_population("fingertip", rng=0)
+
+
+def test_preset_passes_and_the_paper_form_fails(fingertip):
+    rows, _ = physiology.score_physiology(fingertip, PHYSIOLOGY_REFERENCE, properties=NAMES, seed=0)
+    assert all(r["pass"] for r in rows), [r["name"] for r in rows if not r["pass"]]
+    paper = replace(fingertip, current=replace(fingertip.current, shear_sai=0.0, shear_rai=0.0, shear_raii=0.0))
+    rows, _ = physiology.score_physiology(paper, PHYSIOLOGY_REFERENCE, properties=NAMES, seed=0)
+    failing = {r["name"] for r in rows if not r["pass"]}
+    assert {"shear_pref_SAI", "shear_ramp_RAI", "shear_dir_RAI"} <= failing
