@@ -1,5 +1,7 @@
 """The fused pipeline (`ddmm.models.fused`) against the per-stage functions it fuses: the same bits."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -13,7 +15,8 @@ from ddmm.models.rng import normals as keyed_normals
 from ddmm.population import load_spec
 
 FS = 1000.0
-PHYSIO = load_spec("fingertip").current
+#: The fingertip's stage with the shear-magnitude term on (the presets keep it off), so every branch is compared.
+PHYSIO = replace(load_spec("fingertip").current, shear_sai=0.5, shear_rai=4.0, shear_raii=1.0, opponent_shear=1.0)
 #: Afferents in runs of one type (as the encoder orders them), tuned and untuned in each.
 TYPES = ["SAI"] * 4 + ["RAI"] * 4 + ["RAII"] * 3 + ["SAII"] * 3
 NAPS = ["selective", "broad", "none", "bipolar", "broad", "none", "selective", "bipolar",

@@ -12,7 +12,7 @@ from ddmm.population import load_spec, sample_population
 from ddmm.population.simulation import simulate
 from ddmm.population.stimuli.scenes import Scene
 
-PHYSIO = load_spec("fingertip").current
+PHYSIO = replace(load_spec("fingertip").current, shear_sai=0.5, shear_rai=4.0, shear_raii=1.0, opponent_shear=1.0)
 
 
 def test_paper_defaults_have_no_shear_term():
@@ -59,6 +59,7 @@ def test_shear_in_the_preferred_direction_raises_the_drive_and_against_it_lowers
 def test_plan_keeps_afferents_the_shear_term_drives_without_normal_force():
     """Shear with no normal force: the planner must not skip the pressure afferents (their term drives them)."""
     pop = sample_population("fingertip", rng=3)
+    pop = replace(pop, current=PHYSIO)
     pop = pop.select(np.r_[np.flatnonzero(pop.afferent_type == "SAI")[:20], np.flatnonzero(pop.afferent_type == "RAI")[:20]])
     n = 800
     s = np.interp(np.arange(n) / 1000.0, [0, 0.1, 0.4, 0.8], [0, 0, 1.5, 1.5])
