@@ -146,7 +146,25 @@ def _variability_reference(R) -> dict:
 
 def _shear_reference(R) -> dict:
     """Tangential force magnitude, SA-II and SA-I dynamics (docs/references.md rows 4-6, 12, 22, 24)."""
-    return {}
+    inf = float("inf")
+    src = "docs/references.md rows 18, 22: every type responds to tangential force, rising with its magnitude in the "
+    pref, shape = src + "preferred direction", " (shape only, R: a broad range)"
+    return {
+        "shear_pref_SAI": R(1.1, inf, pref + "; shear_sai set by hand to it", "constrained", "R"),
+        "shear_opp_SAI": R(0.0, 0.9, src + "opposite direction lowering the rate" + shape, "held out", "R"),
+        "shear_growth_SAI": R(0.01, inf, pref + ": monotonic growth" + shape, "held out", "R"),
+        "shear_fall_SAI": R(-inf, 0.0, src + "opposite direction: no rise with magnitude" + shape, "held out", "R"),
+        "shear_growth_RAI": R(0.01, inf, pref + ": FA-I ramp responses grow" + shape, "held out", "R"),
+        "shear_dir_RAI": R(1.0, inf, pref + ": FA-I respond more in it than against it" + shape, "held out", "R"),
+        "shear_ramp_RAI": R(0.5, 1.0, src + "FA-I fire during a tangential ramp; shear_rai set by hand to it",
+                            "constrained", "R"),
+        "shear_dir_RAII": R(1.0, inf, pref + ": FA-II respond more in it than against it" + shape, "held out", "R"),
+        "shear_growth_SAII": R(0.01, inf, pref + ": SA-II rates grow with stretch" + shape, "held out", "R"),
+        "shear_variant_SAI": R(0.0, inf, src + "4 N normal, 4 N/s: a variant no gain was set on" + shape,
+                               "held out", "R"),
+        "shear_variant_RAI": R(0.0, inf, src + "4 N normal, 4 N/s: a variant no gain was set on" + shape,
+                               "held out", "R"),
+    }
 
 
 def _slow_reference(R) -> dict:

@@ -17,6 +17,11 @@ shear" (docs/model.md §1.5), selected by ``no_shear``:
   burst whatever its tuning; with the ramp F_A is continuous whenever the
   forces are.
 
+The physiological presets add a shear-magnitude term to the pressure types'
+F_A (`shear_drive`, ``CurrentParams.shear_<type>``): the same signed
+stretch, scaled, so tangential force along an afferent's preferred direction
+raises its drive and against it lowers it.
+
 SA-II (Ruffini) afferents are driven by skin stretch, from forces the
 attenuated *shear* (`stretch_drive`); it needs no threshold, since it
 vanishes with F_S.
@@ -45,6 +50,7 @@ __all__ = [
     "blend_no_shear",
     "profile_factor",
     "stretch_drive",
+    "shear_drive",
 ]
 
 #: Shear threshold F_TH in newtons below which no direction is defined (eq. 17).
@@ -222,6 +228,31 @@ def stretch_drive(fx, fy, af, opponent: float = 0.0, fz=None, normal: float = 0.
         fz = np.asarray(fz, dtype=float)
         drive = drive + normal * (fz[:, None] if fz.ndim == 1 else fz)
     return drive
+
+
+def shear_drive(f_a, fx, fy, af, gain: float, opponent: float = 0.0) -> np.ndarray:
+    """A pressure type's drive with its shear-magnitude term, ``max(F_A + gain * stretch_drive, 0)`` (N).
+
+    ``f_a`` is F_A (shape (n_samples, n_afferents)); ``af`` the profile's own
+    AF on the shear direction (`profile_factor`, no threshold), ``gain`` the
+    type's ``CurrentParams.shear_<type>`` and ``opponent`` its
+    ``opponent_shear``.  With ``gain == 0`` F_A is returned as it is (the
+    paper's drive).  The fused path (`ddmm.models.fused`) runs the same
+    arithmetic in the same order.
+
+    Examples
+    --------
+    >>> shear_drive([[2.0, 0.4]], [0.0], [1.0], [[1.0, 0.2]], 1.0, opponent=1.0).tolist()
+    [[3.0, 0.0]]
+
+    The floor keeps the drive a pressure: a negative drive would read as
+    force to the rectified FA stages.
+    """
+    f_a = np.asarray(f_a, dtype=float)
+    if gain == 0.0:
+        return f_a
+    x = f_a + gain * stretch_drive(fx, fy, af, opponent)
+    return np.where(x > 0.0, x, 0.0)  # floored: shear against the preferred direction silences, never pulls
 
 
 @nb.njit(cache=True, nogil=True, inline="always")

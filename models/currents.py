@@ -38,6 +38,13 @@ which the physiological presets switch on (docs/model.md, "What changed in the m
   after the transducer: ``I + dynamic (I - J) - fall J`` with ``J`` a
   low-pass of the current (``tau_dynamic_sai_s``): an overshoot in fast
   loading and a fractional fall through a hold at every force.
+* **Shear magnitude in the pressure types' drive.**  ``shear_sai``,
+  ``shear_rai`` and ``shear_raii`` add a stretch-like term to F_A before the
+  type's filter, ``x = max(0, F_A + shear_<type> * F_S * (AF - opponent_shear * (1 - AF)))``
+  (AF the profile's own, `attenuation.shear_drive`): tangential force along
+  the preferred direction raises the drive, against it lowers it, growing
+  with F_S (FA-I and FA-II see its derivatives during a tangential ramp).
+  The paper's F_A alone only attenuates: shear can never raise a rate.
 * **Saturating transducers.**  ``i_max_<type>`` bounds the current:
   ``I = i_max * tanh(d / i_max)`` for the linear drive ``d = g * x``, so
   rates stay physiological on fast ramps.  The older log compression
@@ -253,6 +260,14 @@ class CurrentParams:
         constant ``tau_dynamic_sai_s``, a fraction at every force.
     tau_dynamic_sai_s : float
         Ours: time constant of that low-pass in s.
+    shear_sai, shear_rai, shear_raii : float
+        Ours: gain of the shear-magnitude term added to the type's F_A
+        (dimensionless, N of drive per N of shear; 0: the paper's F_A, which
+        shear only attenuates), ``shear * F_S * (AF - opponent_shear (1 - AF))``
+        with AF the profile's own factor (docs/model.md, "What changed").
+    opponent_shear : float
+        Ours: how much shear against the preferred direction lowers the
+        pressure types' shear term (dimensionless, as ``opponent_saii``).
     i_max_sai, i_max_rai, i_max_raii, i_max_saii : float or None
         Ours: bound of the saturating transducer in mV/ms,
         ``I = i_max * tanh(d / i_max)``; None: no bound.
@@ -306,6 +321,10 @@ class CurrentParams:
     dynamic_sai: float = 0.0
     fall_sai: float = 0.0
     tau_dynamic_sai_s: float = 1.0
+    shear_sai: float = 0.0
+    shear_rai: float = 0.0
+    shear_raii: float = 0.0
+    opponent_shear: float = 0.0
     i_max_sai: float | None = None
     i_max_rai: float | None = None
     i_max_raii: float | None = None
@@ -342,7 +361,7 @@ class CurrentParams:
             raise ValueError(f"phase_saii must be a number in [0, 1], got {self.phase_saii!r}")
         for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii", "normal_saii",
                      "bias_cv_saii", "dynamic_sai", "fall_sai", "excite_cv_sai", "excite_cv_rai", "excite_cv_raii",
-                     "excite_cv_saii"):
+                     "excite_cv_saii", "shear_sai", "shear_rai", "shear_raii", "opponent_shear"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -390,7 +409,8 @@ class CurrentParams:
                             float(self._own("negative_weight", afferent_type, default=1.0)),
                             self._own("dynamic", afferent_type, default=0.0),
                             self._own("tau_dynamic", afferent_type, "_s", 1.0),
-                            self._own("bias_cv", afferent_type, default=0.0), self._own("fall", afferent_type, default=0.0))
+                            self._own("bias_cv", afferent_type, default=0.0), self._own("fall", afferent_type, default=0.0),
+                            self._own("shear", afferent_type, default=0.0))
 
 
 @dataclass(frozen=True)
@@ -430,6 +450,8 @@ class CurrentStage:
         Spread of the tonic current across units (SA-II's ``bias_cv_saii``).
     fall : float
         Lasting adaptation of the current (SA-I's ``fall_sai``).
+    shear : float
+        Gain of the shear-magnitude term added to F_A (dimensionless; 0: none).
     """
 
     afferent_type: str
@@ -450,6 +472,7 @@ class CurrentStage:
     tau_dynamic_s: float = 1.0
     bias_cv: float = 0.0
     fall: float = 0.0
+    shear: float = 0.0
 
     @property
     def signed(self) -> bool:

@@ -7,7 +7,7 @@ into tables:
 
 1. **front** (one numba pass): shear magnitude and direction, each
    afferent's profile AF (`attenuation.profile_value`), the no-shear
-   reading, F_A or SA-II's stretch drive, then the type's linear stage
+   reading, F_A (with the presets' shear-magnitude term) or SA-II's stretch drive, then the type's linear stage
    (`_stage_kernels.filter_sections` and `stage_tail`: filter, derivative,
    adaptation, gain, receptor noise);
 2. **transducers**: numpy's vectorised log1p/tanh on each type's columns (a
@@ -47,7 +47,7 @@ __all__ = ["FusedPipeline", "mix_forces", "mixing_matrix"]
 # Rows of the per-afferent float table.
 _COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA, _TONIC = range(13)
 # Rows of the per-group float and integer tables.
-_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _NEGATIVE, _DYN, _ALPHA_DYN, _FALL = range(9)
+_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _NEGATIVE, _DYN, _ALPHA_DYN, _FALL, _SHEAR_G, _OPP_SHEAR = range(11)
 _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = range(9)
 # Rows of the state after the 2 * n_sections filter rows.
 _OFFSET, _Y1, _Y2, _SLOW, _SMOOTH, _DYNC = range(6)
@@ -69,8 +69,22 @@ def _shear(fx, fy, two_fth):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
+def _sheared(p, fz, mag, w, tuned, smooth_reading, outside_value, f_th, shear_g, opp_s):
+    """F_A of a pressure afferent plus its shear-magnitude term (`attenuation.shear_drive`), from its profile
+    AF ``p`` (1 when untuned), in the per-stage path's order of operations."""
+    if not tuned:
+        fa = fz
+    elif smooth_reading:
+        fa = (((p - 1.0) * w) + 1.0) * fz
+    else:
+        fa = (p if mag > f_th else outside_value) * fz
+    x = fa + shear_g * (mag * (p - opp_s * (1.0 - p)))
+    return x if x > 0.0 else 0.0  # `shear_drive`'s floor
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
 def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value, f_th,
-                  opponent, normal, af, cached):
+                  opponent, normal, af, cached, shear_g, opp_s):
     """The drive (newtons) of a group that feels one force, in passes: the profile AF where needed
     (`attenuation.profile_value`), then F_A = AF F_Z under the no-shear reading, or SA-II's stretch
     (`stretch_drive`).  As one loop, the profile's branches kept the whole body scalar, 3-4x slower.
@@ -80,7 +94,7 @@ def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_r
     reused: the same bits, and a fixed-direction ramp or hold costs no
     profile evaluations after its first sample.
     """
-    if tuned and mag > 0.0 and (smooth_reading or stretch or mag > f_th):
+    if tuned and mag > 0.0 and (smooth_reading or stretch or shear_g != 0.0 or mag > f_th):
         if not cached:
             for j in range(lo, hi):
                 af[j] = profile_value(ux, uy, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j], aff_f[_P1, j],
@@ -95,6 +109,9 @@ def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_r
         if normal != 0.0:  # SA-II's normal-force drive (`stretch_drive`)
             for j in range(f.size):
                 f[j] = f[j] + normal * fz
+    elif shear_g != 0.0:
+        for j in range(f.size):
+            f[j] = _sheared(f[j], fz, mag, w, tuned, smooth_reading, outside_value, f_th, shear_g, opp_s)
     elif smooth_reading:
         for j in range(f.size):
             f[j] = (((f[j] - 1.0) * w) + 1.0) * fz
@@ -114,7 +131,7 @@ def mixing_matrix(indptr, indices, coeff, n_sites: int) -> np.ndarray:
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_reading, outside_value, f_th, opponent,
-                 normal, mags, wts):
+                 normal, mags, wts, shear_g, opp_s):
     """`_shared_drive` for afferents that each feel their own force ``local`` (3, n_afferents), in passes:
     shear magnitude and weight, the profile where needed, then the drive (the same arithmetic)."""
     for j in range(lo, hi):
@@ -125,7 +142,7 @@ def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_readin
     for j in range(lo, hi):
         mag = mags[j]
         p = 1.0
-        if tuned and mag > 0.0 and (smooth_reading or stretch or mag > f_th):
+        if tuned and mag > 0.0 and (smooth_reading or stretch or shear_g != 0.0 or mag > f_th):
             p = profile_value(local[0, j] / mag, local[1, j] / mag, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j],
                               aff_f[_P1, j], aff_f[_P2, j], aff_f[_P3, j], aff_f[_P4, j], aff_f[_P5, j],
                               aff_f[_TIP, j])
@@ -136,6 +153,10 @@ def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_readin
         if normal != 0.0:
             for j in range(lo, hi):
                 f[j] = f[j] + normal * local[2, j]
+    elif shear_g != 0.0:
+        for j in range(lo, hi):
+            f[j] = _sheared(f[j], local[2, j], mags[j], wts[j], tuned, smooth_reading, outside_value, f_th, shear_g,
+                            opp_s)
     elif not tuned:
         for j in range(lo, hi):
             f[j] = local[2, j]
@@ -234,16 +255,17 @@ def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, st
             if lo >= hi:
                 continue
             tuned, stretch = grp_i[_TUNED_G, g] != 0, grp_i[_SIGNED, g] != 0
+            shear_g, opp_s = grp_f[_SHEAR_G, g], grp_f[_OPP_SHEAR, g]
             if mixed:
                 _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_reading, outside_value,
-                             f_th, opponent, normal, mags, wts)
-            elif not tuned and not stretch:
+                             f_th, opponent, normal, mags, wts, shear_g, opp_s)
+            elif not tuned and not stretch and shear_g == 0.0:
                 f[lo:hi] = fz  # untuned pressure afferents: F_A = F_Z
             else:
-                profiled = tuned and mag > 0.0 and (smooth_reading or stretch or mag > f_th)
+                profiled = tuned and mag > 0.0 and (smooth_reading or stretch or shear_g != 0.0 or mag > f_th)
                 cached = profiled and ux == af_ux[g] and uy == af_uy[g]
                 _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value,
-                              f_th, opponent, normal, af, cached)
+                              f_th, opponent, normal, af, cached, shear_g, opp_s)
                 if profiled:
                     af_ux[g], af_uy[g] = ux, uy
             if i == 0 and not started and grp_i[_PLAIN, g] == 0:
@@ -364,7 +386,7 @@ class FusedPipeline:
         self.n_afferents, self.fs, self.f_th = afferent_type.size, float(fs), float(f_th)
         self.smooth_reading, self.outside_value = no_shear == "smooth", 1.0 if no_shear == "pass" else 0.0
         self.opponent, self.normal = float(params.opponent_saii), float(params.normal_saii)
-        self.phase_saii = float(params.phase_saii)
+        self.phase_saii, self.opponent_shear = float(params.phase_saii), float(params.opponent_shear)
         change = (afferent_type[1:] != afferent_type[:-1]) | ((nap[1:] == UNTUNED) != (nap[:-1] == UNTUNED))
         bounds = np.flatnonzero(np.r_[True, change, True])  # runs of one type, tuned or not
         spans = list(zip(bounds[:-1], bounds[1:]))
@@ -411,13 +433,14 @@ class FusedPipeline:
 
     def _group_tables(self, spans, consts, noise_cv, tuned):
         n_groups, n_sec = len(spans), max([sos.shape[0] for _, sos, _, _ in consts] + [1])
-        grp_f, grp_i = np.zeros((9, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
+        grp_f, grp_i = np.zeros((11, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
         sos_all = np.zeros((n_groups, n_sec, 6))
         for g, ((a, b), (st, sos, alpha_adapt, alpha_smooth)) in enumerate(zip(spans, consts)):
             sos_all[g, :sos.shape[0]] = sos
             plain = st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
             grp_f[:, g] = [st.adapt, alpha_adapt, st.threshold, alpha_smooth, st.bias, st.negative_weight, st.dynamic,
-                           float(-np.expm1(-1.0 / (self.fs * st.tau_dynamic_s))), st.fall]  # `currents._alpha`
+                           float(-np.expm1(-1.0 / (self.fs * st.tau_dynamic_s))), st.fall,  # `currents._alpha`
+                           st.shear, self.opponent_shear]
             grp_i[:, g] = [sos.shape[0], st.derivative, st.signed, plain, np.any(noise_cv[a:b] > 0),
                            st.tau_s is not None, tuned[a], a, b]
         return grp_f, grp_i, sos_all

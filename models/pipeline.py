@@ -9,7 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from ddmm.models._validation import check_forces, check_positive
-from ddmm.models.attenuation import F_TH, attenuated_force, attenuation_factor, profile_factor, stretch_drive
+from ddmm.models.attenuation import (F_TH, attenuated_force, attenuation_factor, profile_factor, shear_drive,
+                                     stretch_drive)
 from ddmm.models.currents import AFFERENT_TYPES, CurrentParams, afferent_current
 from ddmm.models.engines import SpikeResult, integrate
 
@@ -79,6 +80,12 @@ def compute_currents(
         )
     af = attenuation_factor(fx, fy, theta, profile, k, f_th=f_th, no_shear=no_shear)
     drive = attenuated_force(fz, af)
+    for kind in ("SAI", "RAI", "RAII"):  # the presets' shear-magnitude term (0 by default: F_A as it is)
+        cols = np.flatnonzero(types == kind)
+        gain = current_params.stage(kind).shear
+        if cols.size and gain != 0.0:
+            raw = profile_factor(fx, fy, theta[cols], profile, np.broadcast_to(k, theta.shape)[cols])
+            drive[:, cols] = shear_drive(drive[:, cols], fx, fy, raw, gain, current_params.opponent_shear)
     stretch = np.flatnonzero(types == "SAII")
     if stretch.size:  # SA-II: the attenuated shear (skin stretch), not the normal force
         raw = profile_factor(fx, fy, theta[stretch], profile, np.broadcast_to(k, theta.shape)[stretch])

@@ -399,7 +399,8 @@ _RUNNERS = {"rest": _rest, "on_off": _on_off, "rates": _shipped_rates, "force_co
 
 
 #: Protocol modules beyond the core battery, in the order their protocols run.
-EXTENSIONS = ("physiology_vibration", "physiology_variability", "physiology_slow", "physiology_fields")
+EXTENSIONS = ("physiology_vibration", "physiology_variability", "physiology_slow", "physiology_fields",
+              "physiology_shear")
 _MERGED: set = set()
 
 

@@ -5,12 +5,14 @@ condition, what can be skipped without changing a single spike:
 
 * the NAP/AF stage when no shear ever exceeds F_TH (AF is then 1 under
   ``no_shear="pass"`` and 0 under ``"block"``), or, under ``"smooth"`` and
-  for SA-II's stretch, when there is no shear at all;
+  for SA-II's stretch and the pressure types' shear-magnitude term, when
+  there is no shear at all;
 * spatial weighting when the scene has no contact geometry;
 * afferent types that were not requested;
 * afferents whose current is provably identically zero (no additive noise,
-  and zero normal force, zero receptive-field weight, zero gain, or AF = 0;
-  for SA-II no bias, no shear and, with ``normal_saii``, no normal force): they stay at their resting fixed point
+  and zero normal force or AF = 0 with no shear-magnitude term, or zero
+  receptive-field weight or gain; for SA-II no bias, no shear and, with
+  ``normal_saii``, no normal force): they stay at their resting fixed point
   and never spike.  Drive-proportional noise (``noise_cv``) is zero with the
   drive, so it does not stop an afferent from being skipped; nor does the
   trial excitability (``excite_cv_<type>``), a factor on the current;
@@ -187,7 +189,8 @@ def _quiet(pop, sel, scene, scale, af_stage, af_constant):
     """Afferents whose noise-free current is identically zero (they never leave rest)."""
     stretch = pop.afferent_type[sel] == "SAII"
     blocked = (pop.nap[sel] != UNTUNED) & (not af_stage) & (af_constant == 0.0)
-    pressed = (scale == 0.0) | blocked | (not np.any(scene.fz > 0.0))
+    sheared = _shear_gained(pop, sel) & (scene.max_shear() > 0.0)  # the shear-magnitude term drives them
+    pressed = (scale == 0.0) | ((blocked | (not np.any(scene.fz > 0.0))) & ~sheared)
     bias = pop.current.bias_saii
     pressing = pop.current.normal_saii > 0.0 and bool(np.any(scene.fz != 0.0))  # `normal_saii`
     stretched = (scale == 0.0) | ((scene.max_shear() == 0.0) and not pressing)
@@ -198,6 +201,12 @@ def _excitable(pop, sel) -> np.ndarray:
     """Afferents whose type has a trial excitability (``excite_cv_<type>``): their current differs by trial."""
     types = [t for t in AFFERENT_TYPES if pop.current.excite_cv(t) > 0]
     return np.isin(pop.afferent_type[sel], types)
+
+
+def _shear_gained(pop, sel):
+    """Whether each afferent's drive has a shear-magnitude term (``CurrentParams.shear_<type>`` > 0)."""
+    gain = {t: pop.current.stage(t).shear if t != "SAII" else 0.0 for t in AFFERENT_TYPES}
+    return np.array([gain[t] > 0.0 for t in pop.afferent_type[sel]], dtype=bool)
 
 
 def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
@@ -223,7 +232,7 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
     member = np.where(quiet, -2, -1).astype(np.int64)
     units = np.empty(0, np.int64)
     if deterministic.size:
-        stretch = pop.afferent_type[sel[deterministic]] == "SAII"
+        stretch = (pop.afferent_type[sel[deterministic]] == "SAII") | _shear_gained(pop, sel[deterministic])
         tuned = (pop.nap[sel[deterministic]] != UNTUNED) & np.where(stretch, scene.max_shear() > 0.0, af_stage)
         keys = _unit_keys(pop, sel[deterministic], tuned, scale[deterministic], local)
         _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)

@@ -1,0 +1,37 @@
+"""The shear protocol module (`ddmm.population.analysis.physiology_shear`) in the scorecard."""
+
+from dataclasses import replace
+
+import pytest
+
+from ddmm.experiments.paper_values import PHYSIOLOGY_REFERENCE
+from ddmm.population import sample_population
+from ddmm.population.analysis import physiology, physiology_shear
+
+NAMES = list(physiology_shear.PROPERTIES)
+
+
+def test_rows_are_registered_with_references_half_held_out():
+    assert set(NAMES) <= set(physiology.PROPERTIES)
+    assert set(physiology_shear.PROTOCOLS) <= set(physiology.PROTOCOLS)
+    roles = [PHYSIOLOGY_REFERENCE[n].role for n in NAMES]
+    assert roles.count("held out") >= len(roles) / 2
+
+
+@pytest.fixture(scope="module")
+def fingertip():
+    return sample_population("fingertip", rng=0)
+
+
+#: The term's candidate gains (the presets keep it off: docs/model.md, "What changed in the model").
+ON = {"shear_sai": 0.5, "shear_rai": 4.0, "shear_raii": 1.0, "opponent_shear": 1.0}
+
+
+def test_shear_term_passes_and_the_paper_form_fails(fingertip):
+    on = replace(fingertip, current=replace(fingertip.current, **ON))
+    rows, _ = physiology.score_physiology(on, PHYSIOLOGY_REFERENCE, properties=NAMES, seed=0)
+    assert all(r["pass"] for r in rows), [r["name"] for r in rows if not r["pass"]]
+    paper = replace(fingertip, current=replace(fingertip.current, shear_sai=0.0, shear_rai=0.0, shear_raii=0.0))
+    rows, _ = physiology.score_physiology(paper, PHYSIOLOGY_REFERENCE, properties=NAMES, seed=0)
+    failing = {r["name"] for r in rows if not r["pass"]}
+    assert {"shear_pref_SAI", "shear_ramp_RAI", "shear_dir_RAI"} <= failing
