@@ -3,8 +3,9 @@
 Fitted (per type, SA-I and FA-I, to Birznieks et al. 2001 as the paper reports it):
 
 * tuned fraction (SA-I 93%, FA-I 83%), DSI mean (0.23, 0.24) and SD (0.18, 0.18);
-* by the untuned fraction (NAP ``none``) and the bipolar share of tuned
-  afferents of each type, and for SA-I the transducer: **log compression**
+* by the untuned fraction (NAP ``none``), the bipolar share of tuned
+  afferents and the broad share of tuned unipolar ones of each type, and
+  for SA-I the transducer: **log compression**
   ``i_sat_sai``, with ``g_sai`` tied so that an aligned afferent's drive at
   4 N stays 18 mV/ms (about 40 pulses/s before adaptation).  Without
   compression the 5:1 AF ratio and the steep regular-spiking f-I curve give
@@ -20,8 +21,8 @@ silence, the on/off response (hold rate, adaptation, release), and rates below
 scorecard properties 1-3 (`ddmm.population.analysis.physiology`).
 
 **Fixed, not fitted** (values in the presets, reasons in docs/model.md): the
-stage structure and time constants; selective and broad share the tuned
-unipolar afferents equally; theta_A ranges; gain spread (CV 0.3); noise;
+stage structure and time constants (with the shear-magnitude term, whose
+opponent weights were set by hand); theta_A ranges; gain spread (CV 0.3); noise;
 FA-II copies FA-I's NAP mix; SA-II's NAP mix, bias and gain.
 
 **Held out** (never in an objective): the overall fraction, SA-II and FA-II
@@ -60,19 +61,20 @@ _TOLERANCE = {"tuned": 0.02, "dsi_mean": 0.015, "dsi_sd": 0.025}
 _SAI_ON_CURRENT = 18.0  # mV/ms at 4 N aligned: ~40 pulses/s before adaptation
 
 
-def _nap(untuned: float, bipolar: float) -> dict:
+def _nap(untuned: float, bipolar: float, broad: float = 0.5) -> dict:
     tuned = 1.0 - untuned
-    return {"selective": tuned * (1 - bipolar) / 2, "broad": tuned * (1 - bipolar) / 2,
+    return {"selective": tuned * (1 - bipolar) * (1 - broad), "broad": tuned * (1 - bipolar) * broad,
             "bipolar": tuned * bipolar, "none": untuned}
 
 
 def apply_parameters(spec, kind: str, params: dict):
     """The spec with one type's fitted parameters set.
 
-    ``params``: ``untuned`` and ``bipolar`` fractions, and ``i_sat`` (SAI) or
-    ``gain`` (RAI).
+    ``params``: ``untuned``, ``bipolar`` and ``broad`` fractions, and ``i_sat``
+    (SAI) or ``gain`` (RAI).
     """
-    tspec = dataclasses.replace(spec.types[kind], nap=_nap(params["untuned"], params["bipolar"]))
+    nap = _nap(params["untuned"], params["bipolar"], params.get("broad", 0.5))
+    tspec = dataclasses.replace(spec.types[kind], nap=nap)
     current = spec.current
     if kind == "SAI":
         i_sat = params["i_sat"]
@@ -110,7 +112,7 @@ def constraint_penalty(spec, kind: str, seed: int = FIT_SEEDS[0]) -> float:
 
 
 def _objective(theta, spec, kind, seeds):
-    params = _unpack(theta, kind)
+    params = _unpack(theta, kind, spec)
     trial_spec = apply_parameters(spec, kind, params)
     stats = type_statistics(trial_spec, kind, seeds)
     got = {"tuned": stats["tuned_fraction"][kind], "dsi_mean": stats["dsi"][kind]["mean"],
@@ -119,26 +121,26 @@ def _objective(theta, spec, kind, seeds):
     return misfit + 1e3 * constraint_penalty(trial_spec, kind)
 
 
-def _unpack(theta, kind):
-    untuned = float(np.clip(theta[0], 0.0, 0.6))
-    bipolar = float(np.clip(theta[1], 0.0, 0.9))
+def _unpack(theta, kind, spec):
+    shares = {"untuned": float(np.clip(theta[0], 0.0, 0.6)), "bipolar": float(np.clip(theta[1], 0.0, 0.9)),
+              "broad": float(np.clip(theta[2], 0.0, 1.0))}
     if kind == "SAI":
-        return {"untuned": untuned, "bipolar": bipolar, "i_sat": float(np.exp(theta[2]))}
-    return {"untuned": untuned, "bipolar": bipolar, "gain": RAI_GAIN}
+        return {**shares, "i_sat": spec.current.i_sat_sai}
+    return {**shares, "gain": RAI_GAIN}
 
 
 #: FA-I's gain, fixed (see the module docstring), (mV/ms)/(N/s).
 RAI_GAIN = 6.35
 
 
-def fit_type(spec, kind: str, *, seeds=FIT_SEEDS, max_evaluations: int = 90) -> dict:
-    """Nelder-Mead fit of one type's parameters (3 for SA-I, 2 for FA-I) to its three targets."""
-    start = {"SAI": [0.08, 0.3, np.log(10.0)], "RAI": [0.18, 0.2]}[kind]
-    steps = {"SAI": [0.05, 0.15, 0.4], "RAI": [0.05, 0.15]}[kind]
+def fit_type(spec, kind: str, *, seeds=FIT_SEEDS, max_evaluations: int = 120) -> dict:
+    """Nelder-Mead fit of one type's parameters (4 for SA-I, 3 for FA-I) to its three targets."""
+    start = {"SAI": [0.04, 0.3, 0.5], "RAI": [0.18, 0.2, 0.5]}[kind]
+    steps = {"SAI": [0.05, 0.15, 0.25], "RAI": [0.05, 0.15, 0.25]}[kind]
     simplex = np.array(start) + np.vstack([np.zeros(len(start)), np.diag(steps)])
     res = minimize(_objective, start, args=(spec, kind, seeds), method="Nelder-Mead",
                    options={"maxfev": max_evaluations, "xatol": 1e-3, "fatol": 1e-2, "initial_simplex": simplex})
-    params = _unpack(res.x, kind)
+    params = _unpack(res.x, kind, spec)
     return {**{k: round(v, 4) for k, v in params.items()}, "objective": round(float(res.fun), 3),
             "evaluations": int(res.nfev)}
 
@@ -212,7 +214,7 @@ def _count_toml(t) -> list:
 def spec_to_toml(spec, header: str = "") -> str:
     """TOML text of a spec (the layout `ddmm.population.spec` reads)."""
     lines = [header.rstrip(), f"name = {_toml_value(spec.name)}", f"description = {_toml_value(spec.description)}",
-             "", *_where_toml(spec), "", "[current]"]
+             f"receptive_field = {_toml_value(spec.receptive_field)}", "", *_where_toml(spec), "", "[current]"]
     for f in dataclasses.fields(spec.current):
         value = getattr(spec.current, f.name)
         if value is not None:

@@ -10,7 +10,7 @@ from ddmm.models.currents import AFFERENT_TYPES, type_label
 from ddmm.population.analysis.physiology import FREQUENCIES_HZ
 
 __all__ = ["plot_rest", "plot_on_off", "plot_force_coding", "plot_frequency_tuning", "plot_timing",
-           "plot_cycle_histograms", "physiology_figures"]
+           "plot_cycle_histograms", "plot_shear_magnitude", "physiology_figures"]
 
 
 def plot_rest(data: dict) -> Figure:
@@ -114,12 +114,53 @@ def plot_cycle_histograms(data: dict, bins: int = 20) -> Figure:
     return fig
 
 
+def plot_shear_magnitude(data: dict) -> Figure:
+    """Response against tangential force magnitude on a 2 N press, in the preferred and the opposite direction.
+
+    One panel per type: SA types show the median hold rate (1/s), FA types the mean count during the
+    tangential ramp (the ``shear`` protocol of `ddmm.population.analysis.physiology_shear`).
+
+    Parameters
+    ----------
+    data : dict
+        The ``shear`` protocol's data: ``sa_rate`` and ``fa_count`` (conditions x afferents: no shear, then
+        each magnitude preferred, then each opposite) and ``type`` (type code per afferent).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rate = np.arange(14.0).reshape(7, 2)
+    >>> fig = plot_shear_magnitude({"sa_rate": rate, "fa_count": rate, "type": np.array(["SAI", "RAI"])})
+    >>> len(fig.axes)
+    2
+    """
+    from ddmm.population.analysis.physiology_shear import MAGNITUDES_N
+
+    types = np.asarray(data["type"]).astype(str)
+    kinds = [k for k in AFFERENT_TYPES if np.any(types == k)]
+    fig = Figure(figsize=(3.0 * max(len(kinds), 1), 3.0), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(1, max(len(kinds), 1), squeeze=False)[0])
+    x, n = np.r_[0.0, MAGNITUDES_N], len(MAGNITUDES_N)
+    for ax, kind in zip(axes, kinds):
+        slow = kind.startswith("SA")
+        values = np.asarray(data["sa_rate" if slow else "fa_count"], dtype=float)[:, types == kind]
+        curve = (np.median if slow else np.mean)(values, axis=1)
+        for part, style, label in ((curve[1:1 + n], "-o", "preferred"), (curve[1 + n:], "--s", "opposite")):
+            ax.plot(x, np.r_[curve[0], part], style, color=_TYPE_COLOURS[kind], label=label, ms=4)
+        ax.set_title(f"{type_label(kind)} (n = {int(np.sum(types == kind))})", fontsize=9)
+        ax.set_xlabel("tangential force (N)")
+        ax.set_ylabel("median hold rate (1/s)" if slow else "mean ramp count")
+    axes[0].legend(fontsize=8, frameon=False)
+    return fig
+
+
 def physiology_figures(data: dict, human_dsi: dict) -> dict:
     """File name -> Figure for every protocol that ran and has a figure."""
     makers = {"rest": ("rest.png", plot_rest), "on_off": ("on_off_psth.png", plot_on_off),
               "force_coding": ("force_coding.png", plot_force_coding),
               "frequency": ("frequency_tuning.png", plot_frequency_tuning), "timing": ("timing.png", plot_timing),
-              "phase_locking": ("cycle_histograms.png", plot_cycle_histograms)}
+              "phase_locking": ("cycle_histograms.png", plot_cycle_histograms),
+              "shear": ("shear_magnitude.png", plot_shear_magnitude)}
     out = {name: make(data[protocol]) for protocol, (name, make) in makers.items() if data.get(protocol)}
     if data.get("direction"):
         out["tuning_dsi.png"] = plot_dsi_histograms(data["direction"]["tuning"], human_dsi)

@@ -236,7 +236,7 @@ def shear_drive(f_a, fx, fy, af, gain: float, opponent: float = 0.0) -> np.ndarr
     ``f_a`` is F_A (shape (n_samples, n_afferents)); ``af`` the profile's own
     AF on the shear direction (`profile_factor`, no threshold), ``gain`` the
     type's ``CurrentParams.shear_<type>`` and ``opponent`` its
-    ``opponent_shear``.  With ``gain == 0`` F_A is returned as it is (the
+    ``opponent_shear_<type>``.  With ``gain == 0`` F_A is returned as it is (the
     paper's drive).  The fused path (`ddmm.models.fused`) runs the same
     arithmetic in the same order.
 

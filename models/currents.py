@@ -40,7 +40,7 @@ which the physiological presets switch on (docs/model.md, "What changed in the m
   loading and a fractional fall through a hold at every force.
 * **Shear magnitude in the pressure types' drive.**  ``shear_sai``,
   ``shear_rai`` and ``shear_raii`` add a stretch-like term to F_A before the
-  type's filter, ``x = max(0, F_A + shear_<type> * F_S * (AF - opponent_shear * (1 - AF)))``
+  type's filter, ``x = max(0, F_A + shear_<type> * F_S * (AF - opponent_shear_<type> * (1 - AF)))``
   (AF the profile's own, `attenuation.shear_drive`): tangential force along
   the preferred direction raises the drive, against it lowers it, growing
   with F_S (FA-I and FA-II see its derivatives during a tangential ramp).
@@ -265,9 +265,10 @@ class CurrentParams:
         (dimensionless, N of drive per N of shear; 0: the paper's F_A, which
         shear only attenuates), ``shear * F_S * (AF - opponent_shear (1 - AF))``
         with AF the profile's own factor (docs/model.md, "What changed").
-    opponent_shear : float
+    opponent_shear_sai, opponent_shear_rai, opponent_shear_raii : float
         Ours: how much shear against the preferred direction lowers the
-        pressure types' shear term (dimensionless, as ``opponent_saii``).
+        type's shear term (dimensionless, as ``opponent_saii``; 0: the term
+        is AF F_S, never negative).
     i_max_sai, i_max_rai, i_max_raii, i_max_saii : float or None
         Ours: bound of the saturating transducer in mV/ms,
         ``I = i_max * tanh(d / i_max)``; None: no bound.
@@ -324,7 +325,9 @@ class CurrentParams:
     shear_sai: float = 0.0
     shear_rai: float = 0.0
     shear_raii: float = 0.0
-    opponent_shear: float = 0.0
+    opponent_shear_sai: float = 0.0
+    opponent_shear_rai: float = 0.0
+    opponent_shear_raii: float = 0.0
     i_max_sai: float | None = None
     i_max_rai: float | None = None
     i_max_raii: float | None = None
@@ -361,7 +364,8 @@ class CurrentParams:
             raise ValueError(f"phase_saii must be a number in [0, 1], got {self.phase_saii!r}")
         for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii", "normal_saii",
                      "bias_cv_saii", "dynamic_sai", "fall_sai", "excite_cv_sai", "excite_cv_rai", "excite_cv_raii",
-                     "excite_cv_saii", "shear_sai", "shear_rai", "shear_raii", "opponent_shear"):
+                     "excite_cv_saii", "shear_sai", "shear_rai", "shear_raii", "opponent_shear_sai",
+                     "opponent_shear_rai", "opponent_shear_raii"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -410,7 +414,8 @@ class CurrentParams:
                             self._own("dynamic", afferent_type, default=0.0),
                             self._own("tau_dynamic", afferent_type, "_s", 1.0),
                             self._own("bias_cv", afferent_type, default=0.0), self._own("fall", afferent_type, default=0.0),
-                            self._own("shear", afferent_type, default=0.0))
+                            self._own("shear", afferent_type, default=0.0),
+                            self._own("opponent_shear", afferent_type, default=0.0))
 
 
 @dataclass(frozen=True)
@@ -452,6 +457,8 @@ class CurrentStage:
         Lasting adaptation of the current (SA-I's ``fall_sai``).
     shear : float
         Gain of the shear-magnitude term added to F_A (dimensionless; 0: none).
+    opponent_shear : float
+        How much shear against the preferred direction lowers that term (dimensionless).
     """
 
     afferent_type: str
@@ -473,6 +480,7 @@ class CurrentStage:
     bias_cv: float = 0.0
     fall: float = 0.0
     shear: float = 0.0
+    opponent_shear: float = 0.0
 
     @property
     def signed(self) -> bool:

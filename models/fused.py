@@ -386,7 +386,7 @@ class FusedPipeline:
         self.n_afferents, self.fs, self.f_th = afferent_type.size, float(fs), float(f_th)
         self.smooth_reading, self.outside_value = no_shear == "smooth", 1.0 if no_shear == "pass" else 0.0
         self.opponent, self.normal = float(params.opponent_saii), float(params.normal_saii)
-        self.phase_saii, self.opponent_shear = float(params.phase_saii), float(params.opponent_shear)
+        self.phase_saii = float(params.phase_saii)
         change = (afferent_type[1:] != afferent_type[:-1]) | ((nap[1:] == UNTUNED) != (nap[:-1] == UNTUNED))
         bounds = np.flatnonzero(np.r_[True, change, True])  # runs of one type, tuned or not
         spans = list(zip(bounds[:-1], bounds[1:]))
@@ -440,7 +440,7 @@ class FusedPipeline:
             plain = st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
             grp_f[:, g] = [st.adapt, alpha_adapt, st.threshold, alpha_smooth, st.bias, st.negative_weight, st.dynamic,
                            float(-np.expm1(-1.0 / (self.fs * st.tau_dynamic_s))), st.fall,  # `currents._alpha`
-                           st.shear, self.opponent_shear]
+                           st.shear, st.opponent_shear]
             grp_i[:, g] = [sos.shape[0], st.derivative, st.signed, plain, np.any(noise_cv[a:b] > 0),
                            st.tau_s is not None, tuned[a], a, b]
         return grp_f, grp_i, sos_all

@@ -82,10 +82,10 @@ def compute_currents(
     drive = attenuated_force(fz, af)
     for kind in ("SAI", "RAI", "RAII"):  # the presets' shear-magnitude term (0 by default: F_A as it is)
         cols = np.flatnonzero(types == kind)
-        gain = current_params.stage(kind).shear
-        if cols.size and gain != 0.0:
+        stage = current_params.stage(kind)
+        if cols.size and stage.shear != 0.0:
             raw = profile_factor(fx, fy, theta[cols], profile, np.broadcast_to(k, theta.shape)[cols])
-            drive[:, cols] = shear_drive(drive[:, cols], fx, fy, raw, gain, current_params.opponent_shear)
+            drive[:, cols] = shear_drive(drive[:, cols], fx, fy, raw, stage.shear, stage.opponent_shear)
     stretch = np.flatnonzero(types == "SAII")
     if stretch.size:  # SA-II: the attenuated shear (skin stretch), not the normal force
         raw = profile_factor(fx, fy, theta[stretch], profile, np.broadcast_to(k, theta.shape)[stretch])

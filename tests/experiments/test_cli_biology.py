@@ -57,6 +57,7 @@ def test_calibrated_spec_round_trips_through_toml(name):
     again = spec_from_dict(tomllib.loads(spec_to_toml(spec)))
     assert again.current == spec.current and again.n_afferents() == spec.n_afferents()
     assert again.map == spec.map and again.region == spec.region
+    assert again.receptive_field == spec.receptive_field  # a calibrated preset once lost its tailed fields
     for kind in spec.types:
         assert again.types[kind].nap == pytest.approx(spec.types[kind].nap)
 

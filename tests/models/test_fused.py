@@ -17,7 +17,7 @@ from ddmm.population import load_spec
 FS = 1000.0
 #: The fingertip's stage with the shear-magnitude term on, so every branch is compared.
 PHYSIO = dataclasses.replace(load_spec("fingertip").current, shear_sai=0.5, shear_rai=4.0, shear_raii=1.0,
-                             opponent_shear=1.0)
+                             opponent_shear_sai=1.0, opponent_shear_rai=0.5, opponent_shear_raii=0.25)
 #: The presets with a half-wave FA-II drive too (their FA-I drive already is: negative_weight_rai < 1).
 HALF_WAVE = dataclasses.replace(PHYSIO, negative_weight_raii=0.0)
 #: Afferents in runs of one type (as the encoder orders them), tuned and untuned in each.
@@ -51,7 +51,8 @@ def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite=N
                                                                   no_shear=no_shear))[:, 0]
         if kind != "SAII":  # the presets' shear-magnitude term (a no-op at the paper's defaults)
             raw = profile_factor(fx, fy, theta[j], nap, k[j])
-            drive[:, [j]] = shear_drive(drive[:, [j]], fx, fy, raw, params.stage(kind).shear, params.opponent_shear)
+            drive[:, [j]] = shear_drive(drive[:, [j]], fx, fy, raw, params.stage(kind).shear,
+                                        params.stage(kind).opponent_shear)
     current = np.empty_like(drive)
     for kind in dict.fromkeys(TYPES):
         cols = np.flatnonzero(np.array(TYPES) == kind)
@@ -136,7 +137,7 @@ def test_fused_plan_needs_no_tuned_afferent():
                      PHYSIO, FS, "smooth", 0.1)
     f = forces(1)
     drive = shear_drive(np.column_stack([f[:, 2], f[:, 2]]), f[:, 0], f[:, 1], np.ones((f.shape[0], 2)),
-                        PHYSIO.shear_rai, PHYSIO.opponent_shear)  # untuned: AF = 1, every direction
+                        PHYSIO.shear_rai, PHYSIO.opponent_shear_rai)  # untuned: AF = 1, every direction
     expected, _ = current_core(drive, FS, "RAI", PHYSIO, None, np.ones(2))
     np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False), expected)
 

@@ -12,17 +12,19 @@ from ddmm.population import load_spec, sample_population
 from ddmm.population.simulation import simulate
 from ddmm.population.stimuli.scenes import Scene
 
-PHYSIO = replace(load_spec("fingertip").current, shear_sai=0.5, shear_rai=4.0, shear_raii=1.0, opponent_shear=1.0)
+PHYSIO = replace(load_spec("fingertip").current, shear_sai=0.5, shear_rai=4.0, shear_raii=1.0, opponent_shear_sai=1.0,
+                 opponent_shear_rai=1.0, opponent_shear_raii=1.0)
 
 
 def test_paper_defaults_have_no_shear_term():
     params = CurrentParams()
-    assert (params.shear_sai, params.shear_rai, params.shear_raii, params.opponent_shear) == (0.0, 0.0, 0.0, 0.0)
+    assert (params.shear_sai, params.shear_rai, params.shear_raii, params.opponent_shear_sai) == (0.0, 0.0, 0.0, 0.0)
     f_a = np.array([[2.0, 0.4]])
     np.testing.assert_array_equal(shear_drive(f_a, [0.0], [1.0], [[1.0, 0.2]], 0.0, 1.0), f_a)
 
 
-@pytest.mark.parametrize("name", ["shear_sai", "shear_rai", "shear_raii", "opponent_shear"])
+@pytest.mark.parametrize("name", ["shear_sai", "shear_rai", "shear_raii", "opponent_shear_sai", "opponent_shear_rai",
+                                  "opponent_shear_raii"])
 def test_bad_shear_option_is_refused(name):
     with pytest.raises(ValueError, match=rf"{name} must be a finite number >= 0, got -1\.0"):
         CurrentParams(**{name: -1.0})

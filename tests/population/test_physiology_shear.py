@@ -24,7 +24,8 @@ def fingertip():
 
 
 #: The term's candidate gains (the presets keep it off: docs/model.md, "What changed in the model").
-ON = {"shear_sai": 0.5, "shear_rai": 4.0, "shear_raii": 1.0, "opponent_shear": 1.0}
+ON = {"shear_sai": 0.5, "shear_rai": 4.0, "shear_raii": 1.0, "opponent_shear_sai": 1.0, "opponent_shear_rai": 1.0,
+      "opponent_shear_raii": 1.0}
 
 
 def test_shear_term_passes_and_the_paper_form_fails(fingertip):
