@@ -49,8 +49,9 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
+from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import UNTUNED
-from ddmm.models.currents import AFFERENT_TYPES, CurrentParams, normalize_type
+from ddmm.models.current_params import CurrentParams
 from ddmm.models.nap import PROFILE_NAMES
 from ddmm.population.anatomy import hand_map
 from ddmm.population.anatomy.receptive_fields import check_shape

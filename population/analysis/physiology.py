@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ddmm.models.afferent_types import AFFERENT_TYPES
 from ddmm.models.attenuation import attenuation_factor
-from ddmm.models.currents import AFFERENT_TYPES
 from ddmm.population.stimuli.scenes import Scene, Stage, birznieks, press_push_lift, rotating_shear
 
 __all__ = ["Reference", "Property", "PROPERTIES", "PROTOCOLS", "shipped_scenes", "score_physiology",
