@@ -42,7 +42,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from ddmm.experiments.paper_values import HUMAN_DSI, HUMAN_TUNED_FRACTION, PHYSIOLOGY_REFERENCE
-from ddmm.models.currents import AFFERENT_TYPES
+from ddmm.models.afferent_types import AFFERENT_TYPES
 from ddmm.population import load_spec, sample_population, simulate
 from ddmm.population.analysis.physiology import PROPERTIES, score_physiology
 from ddmm.population.analysis.tuning import DEFAULT_TRIALS, direction_tuning, tuning_scenes, tuning_summary

@@ -29,7 +29,8 @@ from scipy.optimize import brentq
 
 from ddmm.experiments.paper_values import PAPER_TABLE3
 from ddmm.experiments.reproduce import ReproConfig, reproduce_all
-from ddmm.models.currents import PAPER_TYPES, CurrentParams
+from ddmm.models.afferent_types import PAPER_TYPES
+from ddmm.models.current_params import CurrentParams
 from ddmm.models.engines import integrate, substeps_for
 from ddmm.models.metrics import spiking_frequency
 from ddmm.models.pipeline import compute_currents

@@ -9,7 +9,7 @@ TUNING_TRIALS = 5  # ddmm.population.analysis.tuning.DEFAULT_TRIALS, repeated so
 
 from ddmm.experiments.io import atomic_write, ensure_out_dir, save_figure, save_json
 from ddmm.experiments.paper_values import HUMAN_DIRECTION_THRESHOLD_DEG, HUMAN_DSI, HUMAN_TUNED_FRACTION
-from ddmm.models.currents import type_label
+from ddmm.models.afferent_types import type_label
 
 __all__ = ["register", "TUNING_REFERENCE", "run_tuning_stats", "decode_summary"]
 

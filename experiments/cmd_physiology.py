@@ -7,7 +7,7 @@ import math
 
 from ddmm.experiments.io import ensure_out_dir, save_figure, save_json
 from ddmm.experiments.paper_values import HUMAN_DSI
-from ddmm.models.currents import type_label
+from ddmm.models.afferent_types import type_label
 
 __all__ = ["register", "run_scorecard", "scorecard_json"]
 

@@ -29,7 +29,7 @@ def register(sub) -> None:
 def format_table2(result: dict) -> str:
     """Markdown table of our PRSI beside the paper's."""
     from ddmm.experiments.reproduce import PROFILES
-    from ddmm.models.currents import PAPER_TYPES
+    from ddmm.models.afferent_types import PAPER_TYPES
     prsi = result["prsi"]
     lines = ["| type | " + " | ".join(f"{p} ours (paper)" for p in PROFILES) + " | human DSI |",
              "|---" * (len(PROFILES) + 2) + "|"]
@@ -42,7 +42,7 @@ def format_table2(result: dict) -> str:
 def format_table3(result: dict) -> str:
     """Markdown table of our SF at 75/255 deg beside the paper's."""
     from ddmm.experiments.reproduce import PROFILES
-    from ddmm.models.currents import PAPER_TYPES
+    from ddmm.models.afferent_types import PAPER_TYPES
     sf = result["sf"]
     lines = ["| type | " + " | ".join(f"{p} 75° / 255° ours (paper)" for p in PROFILES) + " |",
              "|---" * (len(PROFILES) + 1) + "|"]
@@ -59,7 +59,7 @@ def format_table3(result: dict) -> str:
 def format_fig8(result: dict) -> str:
     """Markdown summary of Fig. 8: peak angle, range and bipolar symmetry."""
     from ddmm.experiments.reproduce import PROFILES
-    from ddmm.models.currents import PAPER_TYPES
+    from ddmm.models.afferent_types import PAPER_TYPES
     sf = result["sf"]
     lines = ["| profile | type | peak theta_T | SF min-max (pulses/s) | SF(θ) = SF(θ+180°) |",
              "|---|---|---|---|---|"]

@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ddmm.experiments.plotting import _TYPE_COLOURS
-from ddmm.models.currents import AFFERENT_TYPES, type_label
+from ddmm.models.afferent_types import AFFERENT_TYPES, type_label
 
 __all__ = ["ramp_and_hold_scene", "ramp_and_hold", "plot_ramp_and_hold"]
 

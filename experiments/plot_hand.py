@@ -9,7 +9,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ddmm.experiments.plotting import _TYPE_COLOURS
-from ddmm.models.currents import AFFERENT_TYPES, type_label
+from ddmm.models.afferent_types import AFFERENT_TYPES, type_label
 from ddmm.population.anatomy import hand_map
 
 __all__ = ["plot_hand", "hand_counts"]

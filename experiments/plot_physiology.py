@@ -6,7 +6,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ddmm.experiments.plotting import _TYPE_COLOURS, plot_dsi_histograms
-from ddmm.models.currents import AFFERENT_TYPES, type_label
+from ddmm.models.afferent_types import AFFERENT_TYPES, type_label
 from ddmm.population.analysis.physiology import FREQUENCIES_HZ
 
 __all__ = ["plot_rest", "plot_on_off", "plot_force_coding", "plot_frequency_tuning", "plot_timing",

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from ddmm.models.currents import AFFERENT_TYPES, PAPER_TYPES, type_label
+from ddmm.models.afferent_types import AFFERENT_TYPES, PAPER_TYPES, type_label
 
 __all__ = ["plot_response", "plot_sf_vs_theta", "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces",
            "plot_dsi_histograms", "plot_preferred_rose", "plot_neurometric", "plot_pareto"]

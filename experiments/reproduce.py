@@ -10,8 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ddmm.models.afferent_types import PAPER_TYPES
 from ddmm.models.attenuation import UNTUNED
-from ddmm.models.currents import PAPER_TYPES, CurrentParams
+from ddmm.models.current_params import CurrentParams
 from ddmm.models.engines import integrate, substeps_for
 from ddmm.models.metrics import direction_index, spiking_frequency
 from ddmm.models.pipeline import compute_currents

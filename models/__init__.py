@@ -4,7 +4,10 @@ Modules, in the order a force becomes spikes:
 
 - `nap`: neural attenuation profiles (Table I) and their boundary radius;
 - `attenuation`: the attenuation factor AF of the shear direction (eqs 9-17);
-- `currents`: type-specific filtering of the attenuated force into currents;
+- `afferent_types`: the type codes, their display labels and accepted spellings;
+- `currents`: type-specific filtering of the attenuated force into currents, with
+  its parameters (`current_params`), filters (`current_filters`) and keyed
+  per-unit and per-trial draws (`variability`);
 - `neuron`: Izhikevich parameters per type (eqs 4-6);
 - `engines`: the registered engines that integrate the neurons (Brian2, direct);
 - `fused`: the whole pipeline for a block of afferents, as the engines consume it;
@@ -20,8 +23,10 @@ from ._lazy import lazy_exports
 
 _WHERE = {
     "attenuation": ("F_TH", "UNTUNED", "attenuated_force", "attenuation_factor", "shear_magnitude"),
-    "currents": ("AFFERENT_TYPES", "CurrentParams", "afferent_current", "filter_force", "normalize_type",
-                 "type_label"),
+    "afferent_types": ("AFFERENT_TYPES", "normalize_type", "type_label"),
+    "current_filters": ("filter_force",),
+    "current_params": ("CurrentParams",),
+    "currents": ("afferent_current",),
     "engines": ("ENGINES", "METHODS", "Engine", "NeuronState", "SpikeResult", "get_engine", "integrate",
                 "substeps_for"),
     "metrics": ("CONTACT_THRESHOLD", "direction_index", "spiking_frequency"),

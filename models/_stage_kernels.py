@@ -183,7 +183,7 @@ def transduce_inplace(drive, stage, excite=None):
 
     ``stage.i_sat`` and ``stage.i_max`` in mV/ms; the sign of SA-II's signed
     drive is restored afterwards.  ``excite`` (per column, dimensionless: the
-    trial excitability of `ddmm.models.currents.excitability`) multiplies
+    trial excitability of `ddmm.models.variability.excitability`) multiplies
     the current after the log compression and before the bound, so
     ``i_max`` still bounds it.
     """

@@ -9,9 +9,17 @@ from __future__ import annotations
 import numpy as np
 
 from ddmm.models._validation import check_forces, check_positive
-from ddmm.models.attenuation import (F_TH, attenuated_force, attenuation_factor, profile_factor, shear_drive,
-                                     stretch_drive)
-from ddmm.models.currents import AFFERENT_TYPES, CurrentParams, afferent_current
+from ddmm.models.afferent_types import AFFERENT_TYPES
+from ddmm.models.attenuation import (
+    F_TH,
+    attenuated_force,
+    attenuation_factor,
+    profile_factor,
+    shear_drive,
+    stretch_drive,
+)
+from ddmm.models.current_params import CurrentParams
+from ddmm.models.currents import afferent_current
 from ddmm.models.engines import SpikeResult, integrate
 
 __all__ = ["compute_currents", "simulate_afferents"]

@@ -14,8 +14,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import UNTUNED
-from ddmm.models.currents import AFFERENT_TYPES, CurrentParams, normalize_type
+from ddmm.models.current_params import CurrentParams
 from ddmm.models.nap import PROFILE_NAMES, k_from_selectivity, validate_k
 from ddmm.population.anatomy import hand_map
 from ddmm.population.anatomy.receptive_fields import check_shape

@@ -19,7 +19,7 @@ import numpy as np
 
 from ddmm.models._validation import check_choice, check_positive
 from ddmm.models.attenuation import F_TH, NO_SHEAR_READINGS
-from ddmm.models.currents import check_fs
+from ddmm.models.current_filters import check_fs
 from ddmm.models.engines import METHODS, get_engine, prepare, substeps_for
 from ddmm.models.fused import FusedPipeline, mixing_matrix
 from ddmm.population._extras import require

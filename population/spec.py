@@ -49,11 +49,12 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
+from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import UNTUNED
-from ddmm.models.currents import AFFERENT_TYPES, CurrentParams, normalize_type
+from ddmm.models.current_params import CurrentParams
 from ddmm.models.nap import PROFILE_NAMES
 from ddmm.population.anatomy import hand_map
-from ddmm.population.anatomy.receptive_fields import RF_SHAPES
+from ddmm.population.anatomy.receptive_fields import check_shape
 
 __all__ = [
     "NAP_CHOICES",
@@ -356,8 +357,7 @@ class PopulationSpec:
     receptive_field: str = "gaussian"
 
     def __post_init__(self):
-        if self.receptive_field not in RF_SHAPES:
-            _fail("receptive_field", f"{self.receptive_field!r} is not a shape; allowed: {', '.join(RF_SHAPES)}")
+        check_shape(self.receptive_field)  # one message for a spec, a population and a weight call
         for kind in self.types:
             if kind not in AFFERENT_TYPES:
                 _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)}")

@@ -33,7 +33,7 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from ddmm.models.currents import AFFERENT_TYPES
+from ddmm.models.afferent_types import AFFERENT_TYPES
 from ddmm.models.metrics import direction_index
 from ddmm.population.stimuli.scenes import birznieks
 

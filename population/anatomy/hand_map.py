@@ -48,7 +48,7 @@ __all__ = ["Ellipse", "Polygon", "HandRegion", "KINDS", "TYPES", "DENSITY_PER_CM
 
 #: Region kinds, each with its own density.
 KINDS = ("fingertip", "finger", "palm")
-#: Afferent types in the package's order (``ddmm.models.currents.AFFERENT_TYPES``).
+#: Afferent types in the package's order (``ddmm.models.afferent_types.AFFERENT_TYPES``).
 TYPES = ("SAI", "RAI", "RAII", "SAII")
 #: Afferents per cm², all types (docs/references.md row 16): fingertip and palm read (V), finger = palm x 1.6.
 DENSITY_PER_CM2 = {"fingertip": 241.0, "finger": 58.0 * 1.6, "palm": 58.0}

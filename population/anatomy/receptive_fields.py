@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models.currents import AFFERENT_TYPES
+from ddmm.models.afferent_types import AFFERENT_TYPES
 from ddmm.population.stimuli.scenes import Contact
 
 __all__ = ["RF_AREA_MM2", "RF_SIGMA_MM", "RF_SUPPORT", "RF_SHAPES", "RF_TAIL_FLOOR", "REFERENCE_AREA_MM2",

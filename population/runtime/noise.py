@@ -19,8 +19,8 @@ length h = 1000/fs ms.  Two terms use it:
   stays silent.
 
 A third term is drawn once per trial, not per sample: the trial
-excitability (``excite_cv_<type>``, `ddmm.models.currents.excitability`),
-the draw of sample ``ddmm.models.currents.EXCITE_SAMPLE`` (2**32 - 1) under
+excitability (``excite_cv_<type>``, `ddmm.models.variability.excitability`),
+the draw of sample ``ddmm.models.variability.EXCITE_SAMPLE`` (2**32 - 1) under
 the same key.
 """
 

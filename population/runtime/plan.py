@@ -32,8 +32,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ddmm.models._validation import check_choice
+from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import F_TH, UNTUNED
-from ddmm.models.currents import AFFERENT_TYPES, bias_multiplier, normalize_type
+from ddmm.models.variability import bias_multiplier
 from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
 
 __all__ = ["RECORD_CHOICES", "ConditionPlan", "Plan", "af_threshold", "make_plan"]

@@ -21,7 +21,7 @@ import numpy as np
 
 from ddmm.models._validation import as_finite_array, check_choice, check_positive
 from ddmm.models.attenuation import NO_SHEAR_READINGS
-from ddmm.models.currents import check_fs
+from ddmm.models.current_filters import check_fs
 from ddmm.models.engines import METHODS, get_engine, substeps_for
 from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
 from ddmm.population.runtime.noise import noise_key, root_seed

@@ -155,7 +155,6 @@ def test_brian2_refuses_an_input_file_it_could_not_read(monkeypatch):
 
 def test_brian2_lanes_live_as_long_as_their_process():
     """A lane's files are kept between runs, removed at exit, and swept once their process is gone."""
-    import os
     import subprocess
     import sys
     from pathlib import Path

@@ -1,0 +1,62 @@
+"""The building blocks of the physiology scorecard's protocol modules: `Property` and the run helpers.
+
+Every protocol module (`physiology_core` and the extensions that
+`ddmm.population.analysis.physiology.load_extensions` registers) describes
+its rows with `Property` (``_p`` pairs a name with one) and runs its scenes
+through the same helpers: ``_knots`` (a normal-force scene through knots),
+``_run`` (`ddmm.population.simulate` with the scorecard's seed and engine),
+``_rates`` (mean rate per afferent in a window) and ``_of`` (a type's mask).
+`ddmm.population.analysis.physiology` re-exports them all.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ddmm.population.stimuli.scenes import Scene
+
+__all__ = ["Property"]
+
+
+@dataclass(frozen=True)
+class Property:
+    """One row of the scorecard: what is measured, on which type, by which protocol."""
+
+    name: str
+    afferent_type: str
+    protocol: str
+    statistic: str
+    unit: str
+
+
+def _p(name, kind, protocol, statistic, unit="1"):
+    """``(name, Property)``: one entry of a protocol module's ``PROPERTIES``."""
+    return name, Property(name, kind, protocol, statistic, unit)
+
+
+def _knots(knots, values, *, fs=1000.0, name="scene", stages=()) -> Scene:
+    """A normal-force scene through (time, force) knots, no shear."""
+    t = np.arange(int(round(knots[-1] * fs))) / fs
+    fz = np.interp(t, knots, values)
+    return Scene(np.zeros_like(fz), np.zeros_like(fz), fz, fs, name, tuple(stages))
+
+
+def _rates(ds, t0, t1, condition=0):
+    """Mean rate (1/s) per afferent in [t0, t1) of one condition, averaged over trials."""
+    keep = (ds.spike_condition.values == condition) & (ds.spike_time.values >= t0) & (ds.spike_time.values < t1)
+    counts = np.bincount(ds.spike_afferent.values[keep], minlength=ds.sizes["afferent"])
+    return counts / ds.sizes["trial"] / (t1 - t0)
+
+
+def _of(ds, kind):
+    """Mask of the afferents of type ``kind`` in a run's dataset."""
+    return ds.afferent_type.values == kind
+
+
+def _run(population, scenes, context, **kwargs):
+    """`ddmm.population.simulate` with the scorecard's engine and seed (``context``), quietly."""
+    from ddmm.population.simulation import simulate
+
+    return simulate(population, scenes, engine=context["engine"], seed=context["seed"], quiet=True, **kwargs)
