@@ -13,6 +13,11 @@ end + 0.1 s).
 
 ``shear_variant``: the same at 4 N normal with the tangential ramp at 4 N/s
 (no gain was set on it: a prediction).
+
+Statistics of the *opposite* direction (and the preferred / opposite ratios)
+use the unipolar afferents only (NAP ``selective`` or ``broad``): a bipolar
+afferent's profile peaks at theta_T and at theta_T + 180 deg, so for it the
+opposite direction is a preferred one, and an untuned afferent has none.
 """
 
 from __future__ import annotations
@@ -38,17 +43,17 @@ def _p(name, kind, protocol, statistic, unit="1"):
 
 PROPERTIES = dict([
     _p("shear_pref_SAI", "SAI", "shear", "median rate, 1 N shear preferred / no shear (2 N normal)"),
-    _p("shear_opp_SAI", "SAI", "shear", "median rate, 1 N shear opposite / no shear (2 N normal)"),
+    _p("shear_opp_SAI", "SAI", "shear", "median rate, 1 N shear opposite / no shear (2 N normal; unipolar)"),
     _p("shear_growth_SAI", "SAI", "shear", "smallest rise of the median rate, 0 -> 0.25 -> 0.5 -> 1 N preferred", "1/s"),
-    _p("shear_fall_SAI", "SAI", "shear", "largest change of the median rate, 0 -> 0.25 -> 0.5 -> 1 N opposite", "1/s"),
+    _p("shear_fall_SAI", "SAI", "shear", "largest change of the median rate, 0 -> 0.25 -> 0.5 -> 1 N opposite (unipolar)", "1/s"),
     _p("shear_growth_RAI", "RAI", "shear", "smallest rise of the mean ramp count, 0 -> 0.25 -> 0.5 -> 1 N preferred"),
-    _p("shear_dir_RAI", "RAI", "shear", "mean ramp count, 1 N preferred / opposite"),
+    _p("shear_dir_RAI", "RAI", "shear", "mean ramp count, 1 N preferred / opposite (unipolar)"),
     _p("shear_ramp_RAI", "RAI", "shear", "fraction firing late in a 2 N/s tangential ramp (0.4-1 N, preferred)"),
-    _p("shear_dir_RAII", "RAII", "shear", "mean ramp count, 1 N preferred / opposite"),
+    _p("shear_dir_RAII", "RAII", "shear", "mean ramp count, 1 N preferred / opposite (unipolar)"),
     _p("shear_growth_SAII", "SAII", "shear", "smallest rise of the median rate, 0 -> 0.25 -> 0.5 -> 1 N preferred",
        "1/s"),
     _p("shear_variant_SAI", "SAI", "shear_variant",
-       "4 N normal, 4 N/s shear: smallest rise of the median rate (preferred), minus largest change (opposite)", "1/s"),
+       "4 N normal, 4 N/s shear: min(smallest rise preferred, -largest change opposite (unipolar))", "1/s"),
     _p("shear_variant_RAI", "RAI", "shear_variant",
        "4 N normal, 4 N/s shear: smallest rise of the mean ramp count, 0 -> 0.25 -> 0.5 -> 1 N preferred"),
 ])
@@ -90,6 +95,11 @@ def _curves(values, mask, stat=np.mean):
     return np.r_[mean[0], mean[1:1 + n]], np.r_[mean[0], mean[1 + n:]]
 
 
+def _unipolar(ds):
+    """Afferents with one preferred direction (NAP selective or broad): the only ones with an opposite one."""
+    return np.isin(ds.nap.values.astype(str), ("selective", "broad"))
+
+
 def _ratio(a, b):
     return float(a / b) if b > 0 else (float("inf") if a > 0 else 1.0)
 
@@ -97,16 +107,19 @@ def _ratio(a, b):
 def _shear(population, context) -> tuple:
     ds, sa, fa, late = _measure(population, context, 2.0, 2.0)
     out, data = {}, {"sa_rate": sa, "fa_count": fa, "type": ds.afferent_type.values}
+    uni = _unipolar(ds)
     if _of(ds, "SAI").any():
-        pref, opp = _curves(sa, _of(ds, "SAI"), np.median)
+        pref = _curves(sa, _of(ds, "SAI"), np.median)[0]
+        opp = _curves(sa, _of(ds, "SAI") & uni, np.median)[1]
         out.update(shear_pref_SAI=_ratio(pref[-1], pref[0]), shear_opp_SAI=_ratio(opp[-1], opp[0]),
                    shear_growth_SAI=float(np.diff(pref).min()), shear_fall_SAI=float(np.diff(opp).max()))
     for kind in ("RAI", "RAII"):
         if _of(ds, kind).any():
-            pref, opp = _curves(fa, _of(ds, kind))
+            pref = _curves(fa, _of(ds, kind))[0]
             if kind == "RAI":  # FA-II code the ramp's corners (transients), not its end value
                 out[f"shear_growth_{kind}"] = float(np.diff(pref).min())
-            out[f"shear_dir_{kind}"] = _ratio(pref[-1], opp[-1])
+            both = _curves(fa, _of(ds, kind) & uni)
+            out[f"shear_dir_{kind}"] = _ratio(both[0][-1], both[1][-1])
     if _of(ds, "RAI").any():
         out["shear_ramp_RAI"] = float(np.mean(late[_of(ds, "RAI")] > 0))
     if _of(ds, "SAII").any():
@@ -118,7 +131,8 @@ def _shear_variant(population, context) -> tuple:
     ds, sa, fa, _ = _measure(population, context, 4.0, 4.0)
     out = {}
     if _of(ds, "SAI").any():
-        pref, opp = _curves(sa, _of(ds, "SAI"), np.median)
+        pref = _curves(sa, _of(ds, "SAI"), np.median)[0]
+        opp = _curves(sa, _of(ds, "SAI") & _unipolar(ds), np.median)[1]
         out["shear_variant_SAI"] = float(min(np.diff(pref).min(), -np.diff(opp).max()))
     if _of(ds, "RAI").any():
         out["shear_variant_RAI"] = float(np.diff(_curves(fa, _of(ds, "RAI"))[0]).min())
