@@ -118,13 +118,15 @@ def plot_shear_magnitude(data: dict) -> Figure:
     """Response against tangential force magnitude on a 2 N press, in the preferred and the opposite direction.
 
     One panel per type: SA types show the median hold rate (1/s), FA types the mean count during the
-    tangential ramp (the ``shear`` protocol of `ddmm.population.analysis.physiology_shear`).
+    tangential ramp (the ``shear`` protocol of `ddmm.population.analysis.physiology_shear`); the
+    opposite direction over unipolar afferents when ``nap`` is given (as the scorecard's rows).
 
     Parameters
     ----------
     data : dict
         The ``shear`` protocol's data: ``sa_rate`` and ``fa_count`` (conditions x afferents: no shear, then
-        each magnitude preferred, then each opposite) and ``type`` (type code per afferent).
+        each magnitude preferred, then each opposite), ``type`` (type code per afferent) and optionally
+        ``nap`` (profile name per afferent).
 
     Examples
     --------
@@ -137,15 +139,20 @@ def plot_shear_magnitude(data: dict) -> Figure:
     from ddmm.population.analysis.physiology_shear import MAGNITUDES_N
 
     types = np.asarray(data["type"]).astype(str)
+    nap = np.asarray(data.get("nap", np.full(types.size, "selective"))).astype(str)
+    unipolar = np.isin(nap, ("selective", "broad"))
     kinds = [k for k in AFFERENT_TYPES if np.any(types == k)]
     fig = Figure(figsize=(3.0 * max(len(kinds), 1), 3.0), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, max(len(kinds), 1), squeeze=False)[0])
     x, n = np.r_[0.0, MAGNITUDES_N], len(MAGNITUDES_N)
     for ax, kind in zip(axes, kinds):
         slow = kind.startswith("SA")
-        values = np.asarray(data["sa_rate" if slow else "fa_count"], dtype=float)[:, types == kind]
-        curve = (np.median if slow else np.mean)(values, axis=1)
-        for part, style, label in ((curve[1:1 + n], "-o", "preferred"), (curve[1 + n:], "--s", "opposite")):
+        values = np.asarray(data["sa_rate" if slow else "fa_count"], dtype=float)
+        stat = np.median if slow else np.mean
+        pref = stat(values[:, types == kind], axis=1)
+        opp = stat(values[:, (types == kind) & unipolar], axis=1) if np.any((types == kind) & unipolar) else pref * np.nan
+        for curve, part, style, label in ((pref, pref[1:1 + n], "-o", "preferred"),
+                                          (opp, opp[1 + n:], "--s", "opposite (unipolar)")):
             ax.plot(x, np.r_[curve[0], part], style, color=_TYPE_COLOURS[kind], label=label, ms=4)
         ax.set_title(f"{type_label(kind)} (n = {int(np.sum(types == kind))})", fontsize=9)
         ax.set_xlabel("tangential force (N)")

@@ -106,7 +106,7 @@ def _ratio(a, b):
 
 def _shear(population, context) -> tuple:
     ds, sa, fa, late = _measure(population, context, 2.0, 2.0)
-    out, data = {}, {"sa_rate": sa, "fa_count": fa, "type": ds.afferent_type.values}
+    out, data = {}, {"sa_rate": sa, "fa_count": fa, "type": ds.afferent_type.values, "nap": ds.nap.values}
     uni = _unipolar(ds)
     if _of(ds, "SAI").any():
         pref = _curves(sa, _of(ds, "SAI"), np.median)[0]
