@@ -55,7 +55,7 @@ def workload(population="fingertip", seed: int = 0, directions=DIRECTIONS, scene
 
 def reference_times(pop, scenes) -> list:
     """Reference spike times (s): one list per scene of one array per afferent."""
-    params = neuron_arrays(pop.afferent_type)
+    params = neuron_arrays(pop.afferent_type, pop.neuron)
     v0, u0 = resting_state(params["b"])
     return [reference_spike_times(population_currents(pop, s), s.fs, params, v0, u0, dt_ref=REF_DT)
             for s in scenes]

@@ -215,6 +215,8 @@ def spec_to_toml(spec, header: str = "") -> str:
     """TOML text of a spec (the layout `ddmm.population.spec` reads)."""
     lines = [header.rstrip(), f"name = {_toml_value(spec.name)}", f"description = {_toml_value(spec.description)}",
              f"receptive_field = {_toml_value(spec.receptive_field)}", "", *_where_toml(spec), "", "[current]"]
+    for kind, params in spec.neuron.items():
+        lines[-1:-1] = [f"[neuron.{kind}]", *(f"{k} = {_toml_value(v)}" for k, v in dataclasses.asdict(params).items()), ""]
     for f in dataclasses.fields(spec.current):
         value = getattr(spec.current, f.name)
         if value is not None:

@@ -367,6 +367,9 @@ class FusedPipeline:
     mixing : ndarray, shape (n_sites, n_afferents), optional
         Each afferent's coefficients of the site forces (`mixing_matrix`):
         the plan then takes site forces and mixes them in its kernel.
+    neuron : dict, optional
+        `ddmm.models.neuron.NeuronParams` by type code, overriding
+        `NEURON_PARAMS` (both engines integrate with them).
 
     Examples
     --------
@@ -377,9 +380,10 @@ class FusedPipeline:
     """
 
     def __init__(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, params, fs, no_shear, f_th,
-                 afferent_id=None, mixing=None):
+                 afferent_id=None, mixing=None, neuron=None):
         afferent_type, nap = np.asarray(afferent_type), np.asarray(nap)
         self.afferent_type, self._neuron_cache, self._bounds = afferent_type, {}, {}
+        self.neuron = dict(neuron or {})  # `NeuronParams` overrides by type (eqs 4-6 otherwise)
         self.mixing = None if mixing is None else np.ascontiguousarray(mixing, dtype=float)
         self.afferent_id = np.ascontiguousarray(np.arange(afferent_type.size) if afferent_id is None else afferent_id,
                                                 dtype=np.int64)
@@ -490,7 +494,7 @@ class FusedPipeline:
         """The direct engine's arguments for (dt, method), cached (as `ddmm.models.engines.direct.run_direct` computes them)."""
         key = (float(dt), method)
         if key not in self._neuron_cache:
-            p = neuron_arrays(self.afferent_type)
+            p = neuron_arrays(self.afferent_type, self.neuron)
             h, half = 1.0 * dt / 0.001, (1.0 * (0.5 * dt)) / 0.001
             self._neuron_cache[key] = (substeps_for(self.fs, dt), METHOD_CODES[method], h, half, p["a"], p["b"],
                                        p["c"], p["d"], V_PEAK, V_FLOOR, BLOCK)

@@ -32,6 +32,7 @@ __all__ = [
     "NEURON_PARAMS",
     "resting_state",
     "neuron_arrays",
+    "check_neuron",
 ]
 
 #: Spike cut-off in mV (eq. 6).
@@ -67,6 +68,18 @@ class NeuronParams:
     b: float = 0.2
     c: float = -65.0
     d: float = 8.0
+
+    def __post_init__(self):
+        for name, low in (("a", 0.0), ("b", 0.0), ("c", None), ("d", 0.0)):
+            value = getattr(self, name)
+            number = isinstance(value, (int, float)) and not isinstance(value, bool)
+            if not number or not np.isfinite(value) or (low is not None and value <= low and name != "d") \
+                    or (name == "d" and value < 0.0):
+                shown = f"{float(value):g}" if number else repr(value)
+                allowed = {"a": "> 0", "b": "in (0, 0.267]", "c": "finite", "d": ">= 0"}[name]
+                raise ValueError(f"{name} must be a finite number {allowed} (mV, mV/ms, 1/ms), got {shown}")
+        if self.b > 0.267:
+            raise ValueError(f"b must be a finite number in (0, 0.267] (a resting state exists), got {self.b:g}")
 
 
 #: Parameters per type: SAI and SAII regular spiking, RAI and RAII low-threshold spiking.
@@ -106,6 +119,27 @@ def resting_state(b) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"b={b!r} leaves eq. 4-5 without a resting state (b must be <= 0.267)")
     v = (-(5.0 - b) - np.sqrt(disc)) / (2.0 * 0.04)
     return v, b * v
+
+
+def check_neuron(neuron, name: str = "neuron") -> None:
+    """Check a table of `NeuronParams` overrides keyed by type code (``"SAI"``, ``"RAI"``, ...).
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming the entry and what is allowed.
+
+    Examples
+    --------
+    >>> check_neuron({"RAII": NeuronParams(a=0.5, b=0.25, d=100.0)})
+    """
+    if not isinstance(neuron, dict):
+        raise TypeError(f"{name} must be a dict of NeuronParams by afferent type, got {type(neuron).__name__}")
+    for kind, params in neuron.items():
+        if kind not in AFFERENT_TYPES:
+            raise ValueError(f"{name}: unknown afferent type {kind!r}; allowed: {', '.join(AFFERENT_TYPES)}")
+        if not isinstance(params, NeuronParams):
+            raise TypeError(f"{name}.{kind} must be a NeuronParams, got {type(params).__name__}")
 
 
 def neuron_arrays(afferent_type, params: dict[str, NeuronParams] | None = None):

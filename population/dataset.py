@@ -70,7 +70,7 @@ def model_attrs(population, config) -> dict:
         "rf_support": RF_SUPPORT,
         "receptive_field": population.receptive_field,
     }
-    for kind, params in NEURON_PARAMS.items():
+    for kind, params in {**NEURON_PARAMS, **population.neuron}.items():
         for name in ("a", "b", "c", "d"):
             attrs[f"neuron_{kind}_{name}"] = getattr(params, name)
     for kind, sigma in RF_SIGMA_MM.items():

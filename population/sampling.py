@@ -18,6 +18,7 @@ from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import UNTUNED
 from ddmm.models.current_params import CurrentParams
 from ddmm.models.nap import PROFILE_NAMES, k_from_selectivity, validate_k
+from ddmm.models.neuron import check_neuron
 from ddmm.population.anatomy import hand_map
 from ddmm.population.anatomy.receptive_fields import check_shape
 from ddmm.population.spec import (
@@ -73,6 +74,9 @@ class Population:
     receptive_field : {"gaussian", "tailed"}
         Shape of the receptive fields' fall-off beyond a contact
         (`ddmm.population.anatomy.receptive_fields`).
+    neuron : dict
+        `ddmm.models.neuron.NeuronParams` by type code overriding the
+        paper's (eqs 4-6, `NEURON_PARAMS`); empty: the paper's neurons.
     """
 
     afferent_type: np.ndarray
@@ -90,9 +94,11 @@ class Population:
     current: CurrentParams = field(default_factory=CurrentParams)
     name: str = "custom"
     receptive_field: str = "gaussian"
+    neuron: dict = field(default_factory=dict)
 
     def __post_init__(self):
         check_shape(self.receptive_field)
+        check_neuron(self.neuron)
         n = len(self.afferent_type)
         if self.region is None:
             object.__setattr__(self, "region", np.full(n, "", dtype=object))
@@ -129,6 +135,7 @@ class Population:
         object.__setattr__(sub, "current", self.current)
         object.__setattr__(sub, "name", self.name)
         object.__setattr__(sub, "receptive_field", self.receptive_field)
+        object.__setattr__(sub, "neuron", self.neuron)
         return sub
 
     def counts(self) -> dict:
@@ -275,7 +282,7 @@ def sample_population(spec, rng=None) -> Population:
     arrays = {name: np.concatenate([p[name] for p in parts]) for name in parts[0]}
     n = len(arrays["theta_t"])
     return Population(**arrays, afferent_id=np.arange(n, dtype=np.int64), current=spec.current, name=spec.name,
-                      receptive_field=spec.receptive_field)
+                      receptive_field=spec.receptive_field, neuron=dict(spec.neuron))
 
 
 def make_population(afferent_type, theta_t=0.0, nap=UNTUNED, k=3.0, *, gain=1.0, x_mm=0.0, y_mm=0.0,

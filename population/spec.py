@@ -53,6 +53,7 @@ from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import UNTUNED
 from ddmm.models.current_params import CurrentParams
 from ddmm.models.nap import PROFILE_NAMES
+from ddmm.models.neuron import NEURON_PARAMS, NeuronParams, check_neuron
 from ddmm.population.anatomy import hand_map
 from ddmm.population.anatomy.receptive_fields import check_shape
 
@@ -346,6 +347,10 @@ class PopulationSpec:
         Fall-off of the receptive fields beyond a contact's edge
         (`ddmm.population.anatomy.receptive_fields`): the Gaussian with a hard
         support (default) or the tailed shape whose fields grow with force.
+    neuron : dict
+        `ddmm.models.neuron.NeuronParams` by type code overriding the paper's
+        neurons (eqs 4-6); TOML ``[neuron.RAII]`` with keys ``a``, ``b``,
+        ``c``, ``d`` (missing keys keep the type's paper values).
     """
 
     name: str = "custom"
@@ -355,9 +360,11 @@ class PopulationSpec:
     description: str = ""
     map: MapSpec | None = None
     receptive_field: str = "gaussian"
+    neuron: dict = field(default_factory=dict)
 
     def __post_init__(self):
         check_shape(self.receptive_field)  # one message for a spec, a population and a weight call
+        check_neuron(self.neuron)
         for kind in self.types:
             if kind not in AFFERENT_TYPES:
                 _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)}")
@@ -458,7 +465,25 @@ def spec_from_dict(data: dict, *, default_name: str = "custom") -> PopulationSpe
         "region": lambda d, k: _build(Region, d, "region"),
         "current": lambda d, k: _build(CurrentParams, d, "current"),
         "map": lambda d, k: _build(MapSpec, d, "map"),
+        "neuron": _neuron_table,
     })
+
+
+def _neuron_table(data, key) -> dict:
+    """``[neuron.<TYPE>]`` tables: `NeuronParams` by type code, each starting from the type's paper values."""
+    if not isinstance(data, dict):
+        _fail(key, f"must be a table of afferent types, got {type(data).__name__}")
+    out = {}
+    for kind, table in data.items():
+        try:
+            code = normalize_type(kind)
+        except ValueError:
+            _fail(f"{key}.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)}")
+        base = NEURON_PARAMS[code]
+        built = _build(NeuronParams, {**dataclasses.asdict(base), **table} if isinstance(table, dict) else table,
+                       f"{key}.{kind}")
+        out[code] = built
+    return out
 
 
 @functools.lru_cache(maxsize=None)

@@ -58,6 +58,7 @@ def test_calibrated_spec_round_trips_through_toml(name):
     assert again.current == spec.current and again.n_afferents() == spec.n_afferents()
     assert again.map == spec.map and again.region == spec.region
     assert again.receptive_field == spec.receptive_field  # a calibrated preset once lost its tailed fields
+    assert again.neuron == spec.neuron
     for kind in spec.types:
         assert again.types[kind].nap == pytest.approx(spec.types[kind].nap)
 
