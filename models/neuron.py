@@ -76,8 +76,8 @@ class NeuronParams:
             if not number or not np.isfinite(value) or (low is not None and value <= low and name != "d") \
                     or (name == "d" and value < 0.0):
                 shown = f"{float(value):g}" if number else repr(value)
-                allowed = {"a": "> 0", "b": "in (0, 0.267]", "c": "finite", "d": ">= 0"}[name]
-                raise ValueError(f"{name} must be a finite number {allowed} (mV, mV/ms, 1/ms), got {shown}")
+                allowed = {"a": "> 0 (1/ms)", "b": "in (0, 0.267]", "c": "(mV)", "d": ">= 0 (mV/ms)"}[name]
+                raise ValueError(f"{name} must be a finite number {allowed}, got {shown}")
         if self.b > 0.267:
             raise ValueError(f"b must be a finite number in (0, 0.267] (a resting state exists), got {self.b:g}")
 
