@@ -70,16 +70,14 @@ class NeuronParams:
     d: float = 8.0
 
     def __post_init__(self):
-        for name, low in (("a", 0.0), ("b", 0.0), ("c", None), ("d", 0.0)):
+        rules = {"a": (lambda x: x > 0.0, "> 0 (1/ms)"), "b": (lambda x: 0.0 < x <= 0.267, "in (0, 0.267]"),
+                 "c": (lambda x: True, "(mV)"), "d": (lambda x: x >= 0.0, ">= 0 (mV/ms)")}  # b: a resting state
+        for name, (ok, allowed) in rules.items():
             value = getattr(self, name)
             number = isinstance(value, (int, float)) and not isinstance(value, bool)
-            if not number or not np.isfinite(value) or (low is not None and value <= low and name != "d") \
-                    or (name == "d" and value < 0.0):
+            if not (number and np.isfinite(value) and ok(value)):
                 shown = f"{float(value):g}" if number else repr(value)
-                allowed = {"a": "> 0 (1/ms)", "b": "in (0, 0.267]", "c": "(mV)", "d": ">= 0 (mV/ms)"}[name]
                 raise ValueError(f"{name} must be a finite number {allowed}, got {shown}")
-        if self.b > 0.267:
-            raise ValueError(f"b must be a finite number in (0, 0.267] (a resting state exists), got {self.b:g}")
 
 
 #: Parameters per type: SAI and SAII regular spiking, RAI and RAII low-threshold spiking.
