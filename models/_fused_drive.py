@@ -1,0 +1,169 @@
+"""The fused pipeline's per-sample drive: table layout, shear, profile AF, F_A or stretch, and site mixing.
+
+Numba kernels of `ddmm.models.fused` (its front pass calls them per sample);
+the arithmetic and its order are those of `ddmm.models.attenuation`, so the
+fused path stays bit-identical to the per-stage one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from ddmm.models.attenuation import profile_value
+
+__all__ = ["mix_forces", "mixing_matrix"]
+
+# Rows of the per-afferent float table.
+_COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA, _TONIC = range(13)
+# Rows of the per-group float and integer tables.
+_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _NEGATIVE, _DYN, _ALPHA_DYN, _FALL, _SHEAR_G, _OPP_SHEAR = range(11)
+_NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = range(9)
+# Rows of the state after the 2 * n_sections filter rows.
+_OFFSET, _Y1, _Y2, _SLOW, _SMOOTH, _DYNC = range(6)
+_N_STATE = 6
+
+_RANGE = 512  # afferents per range of the front pass: its state and scratch fit in cache
+_SLICE = 1 << 17  # current elements per time slice of `FusedPipeline.currents`
+_NO_NORMALS = np.zeros((0, 1)).T  # same layout as a transposed noise block
+_NO_FORCES, _NO_SITES, _NO_WEIGHTS = np.zeros((0, 3)), np.zeros((0, 0, 3)), np.zeros((0, 0))
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _shear(fx, fy, two_fth):
+    """Shear magnitude (N), unit direction and the smooth reading's weight (`transition_weight`)."""
+    mag = math.hypot(fx, fy)
+    ux, uy = (fx / mag, fy / mag) if mag > 0.0 else (0.0, 0.0)
+    x = min(max(mag / two_fth, 0.0), 1.0)
+    return mag, ux, uy, x * x * (3.0 - 2.0 * x)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _sheared(p, fz, mag, w, tuned, smooth_reading, outside_value, f_th, shear_g, opp_s):
+    """F_A of a pressure afferent plus its shear-magnitude term (`attenuation.shear_drive`), from its profile
+    AF ``p`` (1 when untuned), in the per-stage path's order of operations."""
+    if not tuned:
+        fa = fz
+    elif smooth_reading:
+        fa = (((p - 1.0) * w) + 1.0) * fz
+    else:
+        fa = (p if mag > f_th else outside_value) * fz
+    x = fa + shear_g * (mag * (p - opp_s * (1.0 - p)))
+    return x if x > 0.0 else 0.0  # `shear_drive`'s floor
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value, f_th,
+                  opponent, normal, af, cached, shear_g, opp_s):
+    """The drive (newtons) of a group that feels one force, in passes: the profile AF where needed
+    (`attenuation.profile_value`), then F_A = AF F_Z under the no-shear reading, or SA-II's stretch
+    (`stretch_drive`).  As one loop, the profile's branches kept the whole body scalar, 3-4x slower.
+
+    AF depends on the shear direction alone, so ``af[lo:hi]`` keeps the last
+    values computed; with ``cached`` (same ``ux``, ``uy`` as then) they are
+    reused: the same bits, and a fixed-direction ramp or hold costs no
+    profile evaluations after its first sample.
+    """
+    if tuned and mag > 0.0 and (smooth_reading or stretch or shear_g != 0.0 or mag > f_th):
+        if not cached:
+            for j in range(lo, hi):
+                af[j] = profile_value(ux, uy, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j], aff_f[_P1, j],
+                                      aff_f[_P2, j], aff_f[_P3, j], aff_f[_P4, j], aff_f[_P5, j], aff_f[_TIP, j])
+        f[lo:hi] = af[lo:hi]
+    else:
+        f[lo:hi] = 1.0
+    f = f[lo:hi]  # a view from 0: loops over range(lo, hi) vectorise worse
+    if stretch:
+        for j in range(f.size):
+            f[j] = mag * (f[j] - opponent * (1.0 - f[j]))
+        if normal != 0.0:  # SA-II's normal-force drive (`stretch_drive`)
+            for j in range(f.size):
+                f[j] = f[j] + normal * fz
+    elif shear_g != 0.0:
+        for j in range(f.size):
+            f[j] = _sheared(f[j], fz, mag, w, tuned, smooth_reading, outside_value, f_th, shear_g, opp_s)
+    elif smooth_reading:
+        for j in range(f.size):
+            f[j] = (((f[j] - 1.0) * w) + 1.0) * fz
+    else:
+        for j in range(f.size):
+            f[j] = (f[j] if mag > f_th else outside_value) * fz
+
+
+def mixing_matrix(indptr, indices, coeff, n_sites: int) -> np.ndarray:
+    """The sparse local-force coefficients (`ddmm.population.anatomy.receptive_fields.local_mixing`) as a dense (n_sites, n_afferents)."""
+    m = indptr.size - 1
+    out = np.zeros((n_sites, m))
+    rows = np.repeat(np.arange(m), np.diff(indptr))
+    out[indices, rows] = coeff
+    return out
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_reading, outside_value, f_th, opponent,
+                 normal, mags, wts, shear_g, opp_s):
+    """`_shared_drive` for afferents that each feel their own force ``local`` (3, n_afferents), in passes:
+    shear magnitude and weight, the profile where needed, then the drive (the same arithmetic)."""
+    for j in range(lo, hi):
+        mags[j] = math.hypot(local[0, j], local[1, j])
+    for j in range(lo, hi):
+        x = min(max(mags[j] / two_fth, 0.0), 1.0)
+        wts[j] = x * x * (3.0 - 2.0 * x)  # `transition_weight`
+    for j in range(lo, hi):
+        mag = mags[j]
+        p = 1.0
+        if tuned and mag > 0.0 and (smooth_reading or stretch or shear_g != 0.0 or mag > f_th):
+            p = profile_value(local[0, j] / mag, local[1, j] / mag, aff_f[_COS, j], aff_f[_SIN, j], aff_f[_K, j],
+                              aff_f[_P1, j], aff_f[_P2, j], aff_f[_P3, j], aff_f[_P4, j], aff_f[_P5, j],
+                              aff_f[_TIP, j])
+        f[j] = p
+    if stretch:
+        for j in range(lo, hi):
+            f[j] = mags[j] * (f[j] - opponent * (1.0 - f[j]))
+        if normal != 0.0:
+            for j in range(lo, hi):
+                f[j] = f[j] + normal * local[2, j]
+    elif shear_g != 0.0:
+        for j in range(lo, hi):
+            f[j] = _sheared(f[j], local[2, j], mags[j], wts[j], tuned, smooth_reading, outside_value, f_th, shear_g,
+                            opp_s)
+    elif not tuned:
+        for j in range(lo, hi):
+            f[j] = local[2, j]
+    elif smooth_reading:
+        for j in range(lo, hi):
+            f[j] = (((f[j] - 1.0) * wts[j]) + 1.0) * local[2, j]
+    else:
+        for j in range(lo, hi):
+            f[j] = (f[j] if mags[j] > f_th else outside_value) * local[2, j]
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _mix_sample(forces_i, weights, out, a0, a1):
+    """``out[axis, a] = sum_s weights[s, a] forces_i[s, axis]`` for afferents a0..a1, over sites in increasing order."""
+    for axis in range(3):
+        row = out[axis]
+        row[a0:a1] = 0.0
+        for s in range(weights.shape[0]):
+            c = forces_i[s, axis]
+            if c != 0.0:  # adding 0 * w leaves every sum as it is
+                for j in range(a0, a1):
+                    row[j] += weights[s, j] * c
+
+
+@nb.njit(cache=True, nogil=True)
+def mix_forces(forces, weights):
+    """Each afferent's local force, shape (n_samples, 3, n_afferents), from site forces (n_samples, n_sites, 3).
+
+    ``F_a = sum_s weights[s, a] F_s``, summed over sites in increasing order
+    whatever the chunking, so any split of time gives the same bits (the
+    fused kernel mixes sample by sample with the same code).
+    """
+    out = np.empty((forces.shape[0], 3, weights.shape[1]))
+    local = np.empty((3, weights.shape[1]))
+    for i in range(forces.shape[0]):
+        _mix_sample(forces[i], weights, local, 0, weights.shape[1])
+        out[i] = local
+    return out
