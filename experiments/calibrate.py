@@ -57,7 +57,9 @@ FIT_SEEDS = (1000, 1001, 1002, 1003, 1004)
 VALIDATION_SEEDS = (0, 1, 2, 3, 4)
 #: Scorecard protocols whose properties constrain the fit (docs/references.md, checks 1-3).
 CONSTRAINTS = ("rest", "on_off", "rates")
-_TOLERANCE = {"tuned": 0.02, "dsi_mean": 0.015, "dsi_sd": 0.025}
+# The tuned fraction's tolerance is the tightest: at 0.02 the fit gave it up for the DSI and sat 1.3
+# tolerances under the human 93% (0.904 on held-out seeds; one seed's SA-I fell out of its range).
+_TOLERANCE = {"tuned": 0.01, "dsi_mean": 0.015, "dsi_sd": 0.025}
 _SAI_ON_CURRENT = 18.0  # mV/ms at 4 N aligned: ~40 pulses/s before adaptation
 
 

@@ -105,9 +105,12 @@ def _vibration_reference(R) -> dict:
     Row 21 is recalled (R): "VS typically > 0.8 at 1:1", so the ranges are
     broad.  The 1 N rows at 10-60 Hz are ``constrained``: ``tau_rai_s``,
     ``i_max_rai`` and ``negative_weight_rai`` of the presets were chosen on
-    them.  The 2 N variant (15 and 45 Hz) is ``held out``.
+    them, and FA-II's ``t_ref``, drive and smoothing on its 1 N rows at
+    100-250 Hz.  The 2 N variants (15 and 45 Hz; 125 and 175 Hz) are ``held
+    out``.
     """
     lock = "docs/references.md row 21 (R): FA-I entrain at a fixed phase, VS typically > 0.8 at 1:1"
+    lock2 = "docs/references.md row 21 (R): FA-II entrain at a fixed phase, VS typically > 0.8 at 1:1"
     return {
         "vs_RAI": R(0.8, 1.0, lock, "constrained", "R"),
         "locked_RAI": R(0.5, 1.0, lock + "; most afferents 1:1 and locked", "constrained", "R"),
@@ -119,6 +122,15 @@ def _vibration_reference(R) -> dict:
                            "held out", "R"),
         "vs_2f_ratio_RAI_2N": R(0.0, 1.0, lock + "; a 2 N preload at 15 and 45 Hz, never used to set the model",
                                 "held out", "R"),
+        "vs_RAII": R(0.8, 1.0, lock2, "constrained", "R"),
+        "locked_RAII": R(0.5, 1.0, lock2 + "; most afferents 1:1 and locked", "constrained", "R"),
+        "vs_2f_ratio_RAII": R(0.0, 1.0, lock2 + ": one phase per cycle, so VS at 2f < VS at f", "constrained", "R"),
+        "vs_RAII_2N": R(0.8, 1.0, lock2 + "; a 2 N preload at 125 and 175 Hz, never used to set the model",
+                        "held out", "R"),
+        "locked_RAII_2N": R(0.5, 1.0, lock2 + "; a 2 N preload at 125 and 175 Hz, never used to set the model",
+                            "held out", "R"),
+        "vs_2f_ratio_RAII_2N": R(0.0, 1.0, lock2 + "; a 2 N preload at 125 and 175 Hz, never used to set the "
+                                 "model", "held out", "R"),
     }
 
 

@@ -97,7 +97,7 @@ from ddmm.models.currents import excitability, initial_phase, stage_constants, t
 from ddmm.models.engines import NeuronState, check_integration, check_stability, get_engine, run_checked, substeps_for
 from ddmm.models.engines.direct import BLOCK, METHOD_CODES, integrate_parts, integrate_range, part_bounds, spike_checks
 from ddmm.models.nap import get_profile, tip_radius
-from ddmm.models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
+from ddmm.models.neuron import V_FLOOR, V_PEAK, neuron_arrays, refractory_steps, resting_state
 from ddmm.models.rng import normal_row
 
 __all__ = ["FusedPipeline", "mix_forces", "mixing_matrix"]
@@ -227,7 +227,7 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i
 
 @nb.njit(cache=True, nogil=True)
 def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i, sigma_idx,
-                        substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, integrate):
+                        substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor, block, integrate):
     """`_back`, then (if ``integrate``) the direct engine on the current.
 
     Returns spikes, the smallest current, whether the state stayed finite and
@@ -237,8 +237,8 @@ def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f
     lowest = _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i, sigma_idx)
     if not integrate:
         return np.empty(0, np.int64), np.empty(0, np.int64), lowest, True, False
-    idx, stp = integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, 0,
-                                v.size)
+    idx, stp = integrate_range(current, substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor, block,
+                                0, v.size)
     finite, capped, _ = spike_checks(idx, stp, v, u)
     return idx, stp, lowest, finite, capped
 
@@ -367,20 +367,22 @@ class FusedPipeline:
         args = self._neuron_args(dt, method)
         if neuron is None:
             v, u = self.initial_neuron(key, args[5], args[7], args[6])
+            r = np.zeros(v.size)
         else:
             v, u = neuron.v.copy(), neuron.u.copy()
+            r = np.zeros(v.size) if neuron.r is None else neuron.r.copy()
         if not get_engine(engine).fused:  # the pipeline's currents need no second check at the seam
-            params = dict(zip("abcd", args[4:8]))
+            params = {**dict(zip("abcd", args[4:8])), "t_ref": self._t_ref}
             res = run_checked(self.currents(forces, state, started, sample0, key), args[0], dt, params, v, u,
-                              engine, method)
+                              engine, method, r)
             return res.afferent, res.step, res.state
         current, afferent, step, lowest, finite, capped = self.spikes(forces, state, started, sample0, key, args, v,
-                                                                     u, parts)
+                                                                     u, parts, r)
         if method != "euler":
             check_stability(np.array([lowest]), dt, method)
         if not finite or capped:
             check_integration(afferent, step, v, u, current, method, dt)
-        return afferent, step, NeuronState(v, u)
+        return afferent, step, NeuronState(v, u, r)
 
     def initial_neuron(self, key, b, d, c):
         """Neuron state (v, u) before the first sample: at rest, or with ``phase_saii`` and a stream ``key``
@@ -401,8 +403,9 @@ class FusedPipeline:
         if key not in self._neuron_cache:
             p = neuron_arrays(self.afferent_type, self.neuron)
             h, half = 1.0 * dt / 0.001, (1.0 * (0.5 * dt)) / 0.001
+            self._t_ref = p["t_ref"]
             self._neuron_cache[key] = (substeps_for(self.fs, dt), METHOD_CODES[method], h, half, p["a"], p["b"],
-                                       p["c"], p["d"], V_PEAK, V_FLOOR, BLOCK)
+                                       p["c"], p["d"], refractory_steps(p["t_ref"], dt), V_PEAK, V_FLOOR, BLOCK)
         return self._neuron_cache[key]
 
     def new_state(self) -> np.ndarray:
@@ -461,12 +464,13 @@ class FusedPipeline:
               self.rows, self.aff_f, self.grp_f, self.grp_i, self.sigma_idx)
         return current
 
-    def spikes(self, forces, state, started, sample0, key, neuron, v, u, parts=1):
+    def spikes(self, forces, state, started, sample0, key, neuron, v, u, parts=1, r=None):
         """Currents, then the direct engine: (current, afferent, step, smallest current, finite, capped).
 
         Arguments as `currents`; ``neuron`` is (substeps, method code, h,
-        half, a, b, c, d, v_peak, v_floor, block) as `ddmm.models.engines.direct` takes
-        them; ``v``, ``u`` and ``state`` are updated in place.  With
+        half, a, b, c, d, refractory steps, v_peak, v_floor, block) as
+        `ddmm.models.engines.direct` takes them; ``v``, ``u``, ``r`` (refractory
+        steps left; None: zeros) and ``state`` are updated in place.  With
         ``parts`` > 1 the integration runs on that many column ranges in
         parallel (the spikes are the same, ordered range by range).
         """
@@ -474,14 +478,15 @@ class FusedPipeline:
             self._bounds[parts] = part_bounds(v.size, parts)
         bounds = self._bounds[parts]
         current = self._drive(forces, state, started, sample0, key, bounds)
-        substeps, method, h, half, a, b, c, d, v_peak, v_floor, block = neuron
+        substeps, method, h, half, a, b, c, d, nr, v_peak, v_floor, block = neuron
+        r = np.zeros(v.size) if r is None else r
         serial = bounds.size <= 2
         out = _back_and_integrate(current, np.uint64(key or 0), key is not None and self.additive, self.afferent_id,
                                   int(sample0), state, self.rows, self.aff_f, self.grp_f, self.grp_i,
-                                  self.sigma_idx, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
-                                  serial)
+                                  self.sigma_idx, substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor,
+                                  block, serial)
         if not serial:  # from Python, as the front's parallel kernel
-            idx, stp = integrate_parts(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block,
-                                       bounds)
+            idx, stp = integrate_parts(current, substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor,
+                                       block, bounds)
             out = (idx, stp, out[2], *spike_checks(idx, stp, v, u)[:2])
         return (current, *out)

@@ -32,6 +32,7 @@ __all__ = [
     "NEURON_PARAMS",
     "resting_state",
     "neuron_arrays",
+    "refractory_steps",
     "check_neuron",
 ]
 
@@ -62,16 +63,24 @@ class NeuronParams:
         Reset potential in mV (eq. 6).  Paper: -65.
     d : float
         Reset increment of u in mV/ms (eq. 6).  Paper: 8.
+    t_ref : float
+        Absolute refractory period in seconds (not in the paper; 0 there):
+        for ``round(t_ref / dt)`` steps after a spike v is held at C while u
+        evolves, so no interval is shorter than ``(round(t_ref / dt) + 1) dt``
+        (`refractory_steps`).  Without it an Izhikevich neuron at a
+        saturating current fires again within 0.5 ms.
     """
 
     a: float = 0.02
     b: float = 0.2
     c: float = -65.0
     d: float = 8.0
+    t_ref: float = 0.0
 
     def __post_init__(self):
         rules = {"a": (lambda x: x > 0.0, "> 0 (1/ms)"), "b": (lambda x: 0.0 < x <= 0.267, "in (0, 0.267]"),
-                 "c": (lambda x: True, "(mV)"), "d": (lambda x: x >= 0.0, ">= 0 (mV/ms)")}  # b: a resting state
+                 "c": (lambda x: True, "(mV)"), "d": (lambda x: x >= 0.0, ">= 0 (mV/ms)"),
+                 "t_ref": (lambda x: 0.0 <= x <= 0.1, "in [0, 0.1] (s)")}  # b: a resting state
         for name, (ok, allowed) in rules.items():
             value = getattr(self, name)
             number = isinstance(value, (int, float)) and not isinstance(value, bool)
@@ -153,7 +162,8 @@ def neuron_arrays(afferent_type, params: dict[str, NeuronParams] | None = None):
     Returns
     -------
     dict
-        Arrays ``a``, ``b``, ``c``, ``d`` (float64, one entry per afferent).
+        Arrays ``a``, ``b``, ``c``, ``d`` and ``t_ref`` (float64, one entry
+        per afferent).
 
     Examples
     --------
@@ -166,7 +176,25 @@ def neuron_arrays(afferent_type, params: dict[str, NeuronParams] | None = None):
     if any(t != c for t, c in codes.items()):
         types = np.array([codes[t] for t in types.tolist()], dtype=object)
     out = {}
-    for field in ("a", "b", "c", "d"):
+    for field in ("a", "b", "c", "d", "t_ref"):
         lookup = {t: getattr(table[t], field) for t in AFFERENT_TYPES}
         out[field] = np.array([lookup[t] for t in types], dtype=float)
     return out
+
+
+def refractory_steps(t_ref, dt: float) -> np.ndarray:
+    """Steps v is held at C after a spike: ``round(t_ref / dt)``, as float64 (both engines count in floats).
+
+    Parameters
+    ----------
+    t_ref : array_like
+        Absolute refractory periods in seconds (`NeuronParams.t_ref`).
+    dt : float
+        Integration step in seconds.
+
+    Examples
+    --------
+    >>> refractory_steps([0.0, 0.002], 1e-4).tolist()
+    [0.0, 20.0]
+    """
+    return np.rint(np.asarray(t_ref, dtype=float) / dt).astype(float)

@@ -6,7 +6,8 @@ aligned to the sample boundaries; when a step ends at ``v >= 30`` it locates
 the crossing inside the step with the cubic Hermite interpolant built from
 the values and derivatives at both ends (fourth-order accurate, like the
 step), records the spike at that time, resets ``v = c, u = u(t*) + d`` there
-and integrates the rest of the step.  Unlike the grid methods, spike times
+and integrates the rest of the step (after an absolute refractory period
+``t_ref`` with v held at c and u relaxing exactly, when there is one).  Unlike the grid methods, spike times
 are continuous.  ``tests/models/test_reference.py`` checks it against
 `scipy.integrate.solve_ivp` with event detection.
 """
@@ -59,33 +60,48 @@ def _crossing(v0, u0, v1, u1, i, a, b, h, v_peak):
 
 
 @nb.njit(cache=True)
-def _advance(v, u, i, a, b, c, d, h, t, v_peak, out, n):
-    """Integrate [t, t + h]: RK4, then split at every crossing; returns (v, u, n)."""
+def _hold(u, hold, remaining, a, b, c):
+    """Spend up to ``remaining`` ms of an absolute refractory period: v stays at c, u relaxes exactly."""
+    spent = min(hold, remaining)
+    u = b * c + (u - b * c) * np.exp(-a * spent)  # du/dt = a (b c - u) with v = c
+    return u, hold - spent, remaining - spent
+
+
+@nb.njit(cache=True)
+def _advance(v, u, hold, i, a, b, c, d, t_ref, h, t, v_peak, out, n):
+    """Integrate [t, t + h]: RK4, then split at every crossing and hold v for ``t_ref`` ms after it.
+
+    Returns (v, u, refractory time left in ms, n).
+    """
     remaining = h
     while remaining > 0.0:
+        if hold > 0.0:
+            u, hold, remaining = _hold(u, hold, remaining, a, b, c)
+            if remaining <= 1e-15:
+                return v, u, hold, n
         v1, u1 = _rk4(v, u, i, a, b, remaining)
         if not (v1 >= v_peak):
-            return v1, u1, n
+            return v1, u1, hold, n
         s, u_star = _crossing(v, u, v1, u1, i, a, b, remaining, v_peak)
         t_spike = t + (h - remaining) + s * remaining
         if n < out.size:
             out[n] = t_spike
         n += 1
-        v, u = c, u_star + d
+        v, u, hold = c, u_star + d, t_ref
         remaining = remaining * (1.0 - s)
         if remaining < 1e-15:
-            return v, u, n
-    return v, u, n
+            return v, u, hold, n
+    return v, u, hold, n
 
 
 @nb.njit(cache=True, nogil=True)
-def _solve_one(current, sample_ms, steps, a, b, c, d, v, u, v_peak, out):
+def _solve_one(current, sample_ms, steps, a, b, c, d, t_ref, v, u, v_peak, out):
     h = sample_ms / steps
-    n = 0
+    n, hold = 0, 0.0
     for k in range(current.size):
         for s in range(steps):
             t = k * sample_ms + s * h
-            v, u, n = _advance(v, u, current[k], a, b, c, d, h, t, v_peak, out, n)
+            v, u, hold, n = _advance(v, u, hold, current[k], a, b, c, d, t_ref, h, t, v_peak, out, n)
     return n
 
 
@@ -99,7 +115,9 @@ def reference_spike_times(current, fs: float, params: dict, v0, u0, *, dt_ref: f
     fs : float
         Sample rate in Hz.
     params : dict of ndarray
-        Per-neuron ``a``, ``b``, ``c``, ``d`` (see `ddmm.models.neuron.neuron_arrays`).
+        Per-neuron ``a``, ``b``, ``c``, ``d`` and optionally ``t_ref`` in s
+        (see `ddmm.models.neuron.neuron_arrays`): after each spike v is
+        held at c for ``t_ref`` exactly, while u relaxes.
     v0, u0 : ndarray
         Initial state in mV and mV/ms.
     dt_ref : float
@@ -115,13 +133,14 @@ def reference_spike_times(current, fs: float, params: dict, v0, u0, *, dt_ref: f
     steps = int(round((1.0 / fs) / dt_ref))
     if steps < 1 or abs(steps * dt_ref * fs - 1.0) > 1e-9:
         raise ValueError(f"dt_ref={dt_ref!r} s must divide the sample interval 1/fs = {1.0 / fs!r} s")
+    t_ref_ms = 1000.0 * np.asarray(params.get("t_ref", np.zeros(current.shape[0])), dtype=float)
     times = []
     for j in range(current.shape[0]):
         cap = max(64, int(current.shape[1] * sample_ms))  # at most one spike per ms is generous here
         while True:
             out = np.empty(cap)
             n = _solve_one(current[j], sample_ms, steps, params["a"][j], params["b"][j], params["c"][j],
-                           params["d"][j], float(v0[j]), float(u0[j]), V_PEAK, out)
+                           params["d"][j], float(t_ref_ms[j]), float(v0[j]), float(u0[j]), V_PEAK, out)
             if n <= cap:
                 break
             cap = n

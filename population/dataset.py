@@ -71,7 +71,7 @@ def model_attrs(population, config) -> dict:
         "receptive_field": population.receptive_field,
     }
     for kind, params in {**NEURON_PARAMS, **population.neuron}.items():
-        for name in ("a", "b", "c", "d"):
+        for name in ("a", "b", "c", "d", "t_ref"):  # t_ref in s
             attrs[f"neuron_{kind}_{name}"] = getattr(params, name)
     for kind, sigma in RF_SIGMA_MM.items():
         attrs[f"rf_sigma_{kind}_mm"] = sigma

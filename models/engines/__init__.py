@@ -43,10 +43,12 @@ class SpikeCapWarning(RuntimeWarning):
 
 @dataclass(frozen=True)
 class NeuronState:
-    """Membrane state of N neurons: ``v`` in mV and ``u`` in mV/ms."""
+    """Membrane state of N neurons: ``v`` in mV, ``u`` in mV/ms, and ``r`` the refractory steps each has left
+    (whole numbers as float64; None: none, `ddmm.models.neuron.NeuronParams.t_ref`)."""
 
     v: np.ndarray
     u: np.ndarray
+    r: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -116,14 +118,18 @@ def prepare(engine) -> None:
 def _initial_state(state, b, n):
     if state is None:
         v, u = resting_state(b)
-        return np.array(v, dtype=float), np.array(u, dtype=float)
+        return np.array(v, dtype=float), np.array(u, dtype=float), np.zeros(n)
     if not isinstance(state, NeuronState):
         raise TypeError(f"state must be a NeuronState or None, got {type(state).__name__}")
     v = as_finite_array(state.v, "state.v", ndim=1).copy()
     u = as_finite_array(state.u, "state.u", ndim=1).copy()
-    if v.shape != (n,) or u.shape != (n,):
-        raise ValueError(f"state must hold {n} neurons, got v {v.shape} and u {u.shape}")
-    return v, u
+    r = np.zeros(n) if state.r is None else as_finite_array(state.r, "state.r", ndim=1).copy()
+    if v.shape != (n,) or u.shape != (n,) or r.shape != (n,):
+        raise ValueError(f"state must hold {n} neurons, got v {v.shape}, u {u.shape} and r {r.shape}")
+    if np.any((r < 0) | (r != np.rint(r))):
+        bad = float(r[(r < 0) | (r != np.rint(r))][0])
+        raise ValueError(f"state.r must hold whole numbers of steps >= 0, got {bad:g}")
+    return v, u, r
 
 
 def integrate(
@@ -190,27 +196,30 @@ def integrate(
     n = current.shape[1]
     types = np.broadcast_to(np.asarray(afferent_type, dtype=object), (n,))
     params = neuron_arrays(types, neuron_params)
-    v, u = _initial_state(state, params["b"], n)
-    return run_checked(np.ascontiguousarray(current), substeps, dt, params, v, u, engine, method)
+    v, u, r = _initial_state(state, params["b"], n)
+    return run_checked(np.ascontiguousarray(current), substeps, dt, params, v, u, engine, method, r)
 
 
-def run_checked(current, substeps, dt, params, v, u, engine, method) -> SpikeResult:
+def run_checked(current, substeps, dt, params, v, u, engine, method, r=None) -> SpikeResult:
     """`integrate` on inputs already checked: the seam's engines, stability and spike checks.
 
     ``current`` is a finite, C-contiguous float64 (n_samples, n) array in
     mV/ms; ``params`` as `ddmm.models.neuron.neuron_arrays` gives them; ``v`` and
-    ``u`` (mV) are updated in place to the final state.  For callers that
-    made their inputs themselves (`ddmm.models.fused.FusedPipeline.advance`).
+    ``u`` (mV) and ``r`` (refractory steps left; None: zeros) are updated in
+    place to the final state.  For callers that made their inputs themselves
+    (`ddmm.models.fused.FusedPipeline.advance`).
     """
     n = current.shape[1]
+    r = np.zeros(n) if r is None else r
+    params = params if "t_ref" in params else {**params, "t_ref": np.zeros(n)}
     check_stability(current, dt, method)
     if n == 0 or current.shape[0] == 0:
         neuron = step = np.empty(0, np.int64)
     else:
-        neuron, step = get_engine(engine).run(current, substeps, dt, params, v, u, method=method, v_peak=V_PEAK,
+        neuron, step = get_engine(engine).run(current, substeps, dt, params, v, u, r, method=method, v_peak=V_PEAK,
                                               v_floor=V_FLOOR)
     check_integration(neuron, step, v, u, current, method, dt, stacklevel=4)  # the warning names our caller's caller
-    return SpikeResult(neuron, step, NeuronState(v, u), dt, current.shape[0] * substeps)
+    return SpikeResult(neuron, step, NeuronState(v, u, r), dt, current.shape[0] * substeps)
 
 
 def check_stability(current, dt, method) -> None:

@@ -31,6 +31,8 @@ from concurrent.futures import ThreadPoolExecutor
 import numba as nb
 import numpy as np
 
+from ddmm.models.neuron import refractory_steps
+
 __all__ = ["run_direct", "default_threads", "BLOCK", "METHOD_CODES", "integrate_range", "integrate_parts", "part_bounds",
            "spike_checks", "cap_scan"]
 
@@ -114,15 +116,19 @@ def _update(method, h, half, row, a, b, v, u):
 
 
 @nb.njit(cache=True, nogil=True)
-def _block(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, j0, k_start, idx, stp, n):
-    """Advance one block (local arrays a..u, columns j0.. of ``current``) from sample k_start.
+def _block(current, substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor, j0, k_start, idx, stp, n,
+           refractory):
+    """Advance one block (local arrays a..r, columns j0.. of ``current``) from sample k_start.
 
-    Each step: update (``method``), floor v at ``v_floor``, threshold, reset.
-    Spikes go to the fixed buffers ``idx``/``stp`` from position ``n``.  The
-    buffers are never reallocated here (that would stop the update loop from
-    vectorising); when one more sample could overflow them, the kernel
-    returns early and the caller grows them and resumes.  Returns the sample
-    to resume at (``n_samples`` when done) and the new fill level.
+    Each step: update (``method``), floor v at ``v_floor``, hold v at C while
+    the refractory count ``r`` is positive (counting it down; only when
+    ``refractory``, so blocks without it keep the plain loop), threshold,
+    reset (``r`` to ``nr``).  Spikes go to the fixed buffers ``idx``/``stp``
+    from position ``n``.  The buffers are never reallocated here (that would
+    stop the update loop from vectorising); when one more sample could
+    overflow them, the kernel returns early and the caller grows them and
+    resumes.  Returns the sample to resume at (``n_samples`` when done) and
+    the new fill level.
     """
     n_samples = current.shape[0]
     m = v.size
@@ -133,6 +139,21 @@ def _block(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor
         for s in range(substeps):
             step = k * substeps + s
             _update(method, h, half, row, a, b, v, u)
+            if refractory:
+                for j in range(m):
+                    if v[j] < v_floor:
+                        v[j] = v_floor
+                    if r[j] > 0.5:  # Brian2: v held at c, r = clip(r - 1, 0, inf)
+                        v[j] = c[j]
+                        r[j] = r[j] - 1.0
+                    if v[j] >= v_peak:
+                        v[j] = c[j]
+                        u[j] = u[j] + d[j]
+                        r[j] = nr[j]
+                        idx[n] = j0 + j
+                        stp[n] = step
+                        n += 1
+                continue
             for j in range(m):
                 if v[j] < v_floor:
                     v[j] = v_floor
@@ -179,28 +200,38 @@ def _double(buf, n):
 
 
 @nb.njit(cache=True, nogil=True)
-def integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, lo, hi):
-    """Integrate neurons lo..hi (columns of the C-contiguous ``current``); return spikes."""
+def integrate_range(current, substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor, block, lo, hi):
+    """Integrate neurons lo..hi (columns of the C-contiguous ``current``); return spikes.
+
+    ``nr`` holds each neuron's refractory steps and ``r`` the steps it has
+    left (`ddmm.models.neuron.refractory_steps`), updated in place as
+    ``v`` and ``u``.
+    """
     capacity = max(4096, 4 * block * substeps)
     idx, stp, n = np.empty(capacity, np.int64), np.empty(capacity, np.int64), 0
     for j0 in range(lo, hi, block):
         j1 = min(hi, j0 + block)
         # Fresh local copies: LLVM can prove they do not alias and vectorises.
         ab, bb, cb, db = a[j0:j1].copy(), b[j0:j1].copy(), c[j0:j1].copy(), d[j0:j1].copy()
-        vb, ub = v[j0:j1].copy(), u[j0:j1].copy()
+        vb, ub, nrb, rb = v[j0:j1].copy(), u[j0:j1].copy(), nr[j0:j1].copy(), r[j0:j1].copy()
+        refractory = False
+        for j in range(j1 - j0):
+            if nrb[j] > 0.0 or rb[j] > 0.0:
+                refractory = True
         k = 0
         while k < current.shape[0]:
-            k, n = _block(current, substeps, method, h, half, ab, bb, cb, db, vb, ub, v_peak, v_floor, j0, k,
-                          idx, stp, n)
+            k, n = _block(current, substeps, method, h, half, ab, bb, cb, db, nrb, vb, ub, rb, v_peak, v_floor, j0,
+                          k, idx, stp, n, refractory)
             if k < current.shape[0]:  # buffers nearly full: double them and resume
                 idx, stp = _double(idx, n), _double(stp, n)
         v[j0:j1] = vb
         u[j0:j1] = ub
+        r[j0:j1] = rb
     return idx[:n].copy(), stp[:n].copy()
 
 
 @nb.njit(cache=True, nogil=True, parallel=True)
-def integrate_parts(current, substeps, method, h, half, a, b, c, d, v, u, v_peak, v_floor, block, bounds):
+def integrate_parts(current, substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor, block, bounds):
     """`integrate_range` on the column ranges ``bounds[p]..bounds[p+1]`` in parallel (numba threads).
 
     For a latency-bound caller (the streaming encoder's 1 ms chunk): one
@@ -212,8 +243,8 @@ def integrate_parts(current, substeps, method, h, half, a, b, c, d, v, u, v_peak
     idx_parts = [np.empty(0, np.int64) for _ in range(n_parts)]
     stp_parts = [np.empty(0, np.int64) for _ in range(n_parts)]
     for p in nb.prange(n_parts):
-        idx_parts[p], stp_parts[p] = integrate_range(current, substeps, method, h, half, a, b, c, d, v, u, v_peak,
-                                                      v_floor, block, bounds[p], bounds[p + 1])
+        idx_parts[p], stp_parts[p] = integrate_range(current, substeps, method, h, half, a, b, c, d, nr, v, u, r,
+                                                      v_peak, v_floor, block, bounds[p], bounds[p + 1])
     return _concatenate(idx_parts), _concatenate(stp_parts)
 
 
@@ -247,7 +278,8 @@ def _executor(threads: int) -> ThreadPoolExecutor:
     return _EXECUTOR
 
 
-def run_direct(current, substeps, dt, params, v, u, method="euler", v_peak=30.0, v_floor=-100.0, threads=None):
+def run_direct(current, substeps, dt, params, v, u, r=None, method="euler", v_peak=30.0, v_floor=-100.0,
+               threads=None):
     """Integrate eqs 4-6 for N neurons with the direct engine.
 
     Parameters
@@ -259,9 +291,13 @@ def run_direct(current, substeps, dt, params, v, u, method="euler", v_peak=30.0,
     dt : float
         Step in seconds.
     params : dict of ndarray
-        Per-neuron ``a``, ``b``, ``c``, ``d`` (see `ddmm.models.neuron`).
+        Per-neuron ``a``, ``b``, ``c``, ``d`` and optionally ``t_ref`` in
+        seconds (see `ddmm.models.neuron`; no ``t_ref``: none).
     v, u : ndarray, shape (n_neurons,)
         Initial state in mV and mV/ms; updated in place to the final state.
+    r : ndarray, shape (n_neurons,), optional
+        Refractory steps left (whole numbers as float64; None: zeros);
+        updated in place.
     method : {"euler", "rk2", "rk4", "izhikevich2003"}
         Integration scheme.
     v_peak : float
@@ -284,11 +320,13 @@ def run_direct(current, substeps, dt, params, v, u, method="euler", v_peak=30.0,
     threads = default_threads() if threads is None else threads
     bounds = part_bounds(n_neurons, threads)  # a neuron's block never depends on threads
     args = [params[p] for p in ("a", "b", "c", "d")]
+    args.append(refractory_steps(params.get("t_ref", np.zeros(n_neurons)), dt))
+    r = np.zeros(n_neurons) if r is None else r
 
     # The whole C-contiguous array goes to every thread (a column slice would
     # be strided and defeat vectorisation); each thread owns a column range.
     def work(lo, hi):
-        return integrate_range(current, substeps, METHOD_CODES[method], h, half, *args, v, u, v_peak, v_floor,
+        return integrate_range(current, substeps, METHOD_CODES[method], h, half, *args, v, u, r, v_peak, v_floor,
                                 BLOCK, int(lo), int(hi))
 
     ranges = list(zip(bounds[:-1], bounds[1:]))

@@ -54,8 +54,13 @@ class Engine:
         """Column ranges a streaming push integrates in parallel (1: serial)."""
         return 1
 
-    def run(self, current, substeps, dt, params, v, u, *, method, v_peak, v_floor):
-        """Integrate checked inputs; return (neuron, step) int64 arrays, ``v``/``u`` updated in place."""
+    def run(self, current, substeps, dt, params, v, u, r, *, method, v_peak, v_floor):
+        """Integrate checked inputs; return (neuron, step) int64 arrays, ``v``/``u``/``r`` updated in place.
+
+        ``params`` holds per-neuron ``a``, ``b``, ``c``, ``d`` and ``t_ref``
+        (s); ``r`` the refractory steps each neuron has left
+        (`ddmm.models.neuron.refractory_steps`).
+        """
         raise NotImplementedError
 
     def __repr__(self) -> str:
@@ -84,10 +89,10 @@ class DirectEngine(Engine):
 
         return default_threads() if n_afferents >= self.parallel_min_afferents else 1
 
-    def run(self, current, substeps, dt, params, v, u, *, method, v_peak, v_floor):
+    def run(self, current, substeps, dt, params, v, u, r, *, method, v_peak, v_floor):
         from .direct import run_direct
 
-        return run_direct(current, substeps, dt, params, v, u, method=method, v_peak=v_peak, v_floor=v_floor)
+        return run_direct(current, substeps, dt, params, v, u, r, method=method, v_peak=v_peak, v_floor=v_floor)
 
 
 class Brian2Engine(Engine):
@@ -101,10 +106,10 @@ class Brian2Engine(Engine):
 
         _import_brian2()
 
-    def run(self, current, substeps, dt, params, v, u, *, method, v_peak, v_floor):
+    def run(self, current, substeps, dt, params, v, u, r, *, method, v_peak, v_floor):
         from .brian2.engine import run_brian2
 
-        return run_brian2(current, substeps, dt, params, v, u, method=method, v_peak=v_peak, v_floor=v_floor)
+        return run_brian2(current, substeps, dt, params, v, u, r, method=method, v_peak=v_peak, v_floor=v_floor)
 
 
 def register_engine(engine: Engine) -> Engine:

@@ -10,7 +10,8 @@ Protocols (forces in N, +Z into the skin):
   grid amplitude giving at least one spike per cycle in the steady window
   (0.1-0.5 s), and the vector strength (VS) of its spike phases there, at the
   stimulus frequency f and at 2f.  The same on a 2 N preload at 15 and 45 Hz
-  (a variant never used to set the model).
+  (a variant never used to set the model).  The same for 20 FA-II at 100,
+  150, 200 and 250 Hz on 1 N, and on 2 N at 125 and 175 Hz (the variant).
 
 `vibration_rate_sai` (not a row: the presets fail it, see docs/model.md):
 SA-I on a 1.5 N preload, static or with a 0.3 N sinusoid at 5 and 10 Hz,
@@ -30,23 +31,31 @@ from ddmm.population.stimuli.scenes import Scene, Stage
 __all__ = ["PROPERTIES", "PROTOCOLS", "RUNNERS", "vector_strength", "locking_at_threshold", "vibration_scene",
            "vibration_rate_sai"]
 
-PROPERTIES = dict([
-    _ph._p("vs_RAI", "RAI", "phase_locking", "median VS at f, 1:1 amplitude, 10-60 Hz on 1 N"),
-    _ph._p("locked_RAI", "RAI", "phase_locking", "fraction 1:1 and locked (VS > 0.8), 10-60 Hz on 1 N"),
-    _ph._p("vs_2f_ratio_RAI", "RAI", "phase_locking", "median VS at 2f / VS at f, 1:1 amplitude, 10-60 Hz"),
-    _ph._p("vs_RAI_2N", "RAI", "phase_locking", "median VS at f, 1:1 amplitude, 15 and 45 Hz on 2 N"),
-    _ph._p("locked_RAI_2N", "RAI", "phase_locking", "fraction 1:1 and locked (VS > 0.8), 15 and 45 Hz on 2 N"),
-    _ph._p("vs_2f_ratio_RAI_2N", "RAI", "phase_locking", "median VS at 2f / VS at f, 15 and 45 Hz on 2 N"),
-])
+
+def _rows(kind: str, band: str, variant: str) -> list:
+    """The six rows of one type: VS, locked fraction and VS(2f)/VS(f) on 1 N (``band``) and on 2 N (``variant``)."""
+    return [
+        _ph._p(f"vs_{kind}", kind, "phase_locking", f"median VS at f, 1:1 amplitude, {band} on 1 N"),
+        _ph._p(f"locked_{kind}", kind, "phase_locking", f"fraction 1:1 and locked (VS > 0.8), {band} on 1 N"),
+        _ph._p(f"vs_2f_ratio_{kind}", kind, "phase_locking", f"median VS at 2f / VS at f, 1:1 amplitude, {band}"),
+        _ph._p(f"vs_{kind}_2N", kind, "phase_locking", f"median VS at f, 1:1 amplitude, {variant} on 2 N"),
+        _ph._p(f"locked_{kind}_2N", kind, "phase_locking", f"fraction 1:1 and locked (VS > 0.8), {variant} on 2 N"),
+        _ph._p(f"vs_2f_ratio_{kind}_2N", kind, "phase_locking", f"median VS at 2f / VS at f, {variant} on 2 N"),
+    ]
+
+
+PROPERTIES = dict(_rows("RAI", "10-60 Hz", "15 and 45 Hz") + _rows("RAII", "100-250 Hz", "125 and 175 Hz"))
 PROTOCOLS = ("phase_locking",)
 
 FREQUENCIES_RAI_HZ = (10.0, 20.0, 40.0, 60.0)
 VARIANT_HZ = (15.0, 45.0)
+FREQUENCIES_RAII_HZ = (100.0, 150.0, 200.0, 250.0)
+VARIANT_RAII_HZ = (125.0, 175.0)
 AMPLITUDES_N = tuple(np.geomspace(1e-3, 1.0, 25))
 LOCKED_VS = 0.8
 _N_AFFERENTS = 20
 #: The frequency (Hz) of each type's cycle histogram in the figure data.
-CYCLE_HISTOGRAM_HZ = {"RAI": 20.0, "SAI": 10.0}
+CYCLE_HISTOGRAM_HZ = {"RAI": 20.0, "RAII": 150.0, "SAI": 10.0}
 _FS = 5000.0
 
 
@@ -105,9 +114,9 @@ def locking_at_threshold(ds, frequencies, amplitudes, window=_ph._VIBRATION_WIND
     return vs1, vs2, [np.concatenate(p) if p else np.zeros(0) for p in phases]
 
 
-def _locking(population, context, frequencies, preload_n):
-    """(VS at f, VS at 2f) of up to 20 FA-I afferents (chosen by the seed) at their 1:1 amplitudes."""
-    idx = np.flatnonzero(population.afferent_type == "RAI")
+def _locking(population, context, frequencies, preload_n, kind="RAI"):
+    """(VS at f, VS at 2f) of up to 20 afferents of ``kind`` (chosen by the seed) at their 1:1 amplitudes."""
+    idx = np.flatnonzero(population.afferent_type == kind)
     pick = np.random.default_rng(context["seed"]).choice(idx, min(idx.size, _N_AFFERENTS), replace=False)
     sub = population.select(np.sort(pick))
     scenes = [vibration_scene(f, a, f"lock_{f:g}_{i}", preload_n) for f in frequencies
@@ -126,15 +135,20 @@ def _summary(vs1, vs2):
 
 
 def _phase_locking(population, context):
-    vs1, vs2, phases = _locking(population, context, FREQUENCIES_RAI_HZ, 1.0)
-    w1, w2, _ = _locking(population, context, VARIANT_HZ, 2.0)
-    vs, locked, ratio = _summary(vs1, vs2)
-    vs_2n, locked_2n, ratio_2n = _summary(w1, w2)
-    values = {"vs_RAI": vs, "locked_RAI": locked, "vs_2f_ratio_RAI": ratio, "vs_RAI_2N": vs_2n,
-              "locked_RAI_2N": locked_2n, "vs_2f_ratio_RAI_2N": ratio_2n}
-    shown = FREQUENCIES_RAI_HZ.index(CYCLE_HISTOGRAM_HZ["RAI"])
-    return values, {"RAI": {"frequencies": FREQUENCIES_RAI_HZ, "vs": vs1, "vs_2f": vs2,
-                            "frequency_hz": CYCLE_HISTOGRAM_HZ["RAI"], "phases": phases[shown]}}
+    values, data = {}, {}
+    for kind, frequencies, variant in (("RAI", FREQUENCIES_RAI_HZ, VARIANT_HZ),
+                                       ("RAII", FREQUENCIES_RAII_HZ, VARIANT_RAII_HZ)):
+        if not np.any(population.afferent_type == kind):
+            continue
+        vs1, vs2, phases = _locking(population, context, frequencies, 1.0, kind)
+        w1, w2, _ = _locking(population, context, variant, 2.0, kind)
+        for suffix, stats in (("", _summary(vs1, vs2)), ("_2N", _summary(w1, w2))):
+            for name, value in zip(("vs_{}", "locked_{}", "vs_2f_ratio_{}"), stats):
+                values[name.format(kind) + suffix] = value
+        shown = frequencies.index(CYCLE_HISTOGRAM_HZ[kind])
+        data[kind] = {"frequencies": frequencies, "vs": vs1, "vs_2f": vs2, "frequency_hz": CYCLE_HISTOGRAM_HZ[kind],
+                      "phases": phases[shown]}
+    return values, data
 
 
 def _vibration_sai(population, context):

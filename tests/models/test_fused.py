@@ -156,7 +156,7 @@ def test_fused_spikes_equal_the_direct_engine(method):
     p = neuron_arrays(np.array(TYPES))
     v, u = (np.array(x, dtype=float) for x in resting_state(p["b"]))
     neuron = (10, METHOD_CODES[method], 1.0 * 1e-4 / 0.001, (1.0 * (0.5 * 1e-4)) / 0.001, p["a"], p["b"], p["c"],
-              p["d"], V_PEAK, V_FLOOR, BLOCK)
+              p["d"], np.zeros(len(TYPES)), V_PEAK, V_FLOOR, BLOCK)
     _, afferent, step, _, finite, capped = plan.spikes(f, plan.new_state(), False, 0, None, neuron, v, u)
     assert finite and not capped and afferent.size > 10
     order = np.lexsort((afferent, step))

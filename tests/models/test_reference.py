@@ -49,3 +49,25 @@ def test_reference_bad_step():
     p = neuron_arrays(["SAI"])
     with pytest.raises(ValueError, match="dt_ref"):
         reference_spike_times(np.zeros((3, 1)), 1000.0, p, [-70.0], [-14.0], dt_ref=3e-4)
+
+
+def test_refractory_hold_agrees_with_a_grid_engine_as_dt_shrinks():
+    """With t_ref the reference holds v at c for exactly t_ref; the grid engines converge to it."""
+    from ddmm.models.engines import integrate
+    from ddmm.models.neuron import NeuronParams
+
+    current = np.repeat([[60.0], [150.0], [20.0], [250.0]], 25, axis=0)  # 100 ms at 1 kHz
+    neuron = {"RAII": NeuronParams(b=0.25, t_ref=0.002)}
+    p = neuron_arrays(["RAII"], neuron)
+    v0, u0 = resting_state(p["b"])
+    ref = reference_spike_times(current, 1000.0, p, v0, u0, dt_ref=1e-6)[0]
+    free = reference_spike_times(current, 1000.0, {**p, "t_ref": np.zeros(1)}, v0, u0, dt_ref=1e-6)[0]
+    assert np.diff(ref).min() >= 0.002 and np.diff(free).min() < 0.002 and ref.size < free.size
+    errors = []
+    for dt in (1e-5, 2.5e-6):
+        res = integrate(current, fs=1000.0, dt=dt, afferent_type="RAII", engine="direct", method="rk4",
+                        neuron_params=neuron)
+        assert res.time.size == ref.size
+        errors.append(np.abs(res.time - ref).max())
+    # first order: each spike time and each period start round to a step, and the offsets add up spike by spike
+    assert errors[1] < errors[0] / 3 and errors[1] < 3e-5

@@ -21,7 +21,8 @@ def test_spec_table_starts_from_the_types_paper_values():
     spec = spec_from_dict({"types": {"RAII": {"count": 3}}, "neuron": {"FA-II": {"a": 0.5, "d": 100.0}}})
     assert spec.neuron == {"RAII": NeuronParams(a=0.5, b=NEURON_PARAMS["RAII"].b, c=-65.0, d=100.0)}
     assert sample_population(spec, rng=0).neuron == spec.neuron
-    assert load_spec("fingertip").neuron == {}  # the presets keep the paper's neurons
+    # the presets keep the paper's neurons but FA-II's (a refractory period and a smaller D, docs/model.md)
+    assert load_spec("fingertip").neuron == {"RAII": NeuronParams(b=0.25, d=2.0, t_ref=0.002)}
 
 
 @pytest.mark.parametrize(("table", "match"), [
@@ -29,6 +30,8 @@ def test_spec_table_starts_from_the_types_paper_values():
     ({"RAII": {"a": 0.0}}, "a must be a finite number > 0"),
     ({"RAII": {"d": -1.0}}, "d must be a finite number >= 0"),
     ({"RAII": {"b": 0.3}}, r"b must be a finite number in \(0, 0.267\]"),
+    ({"RAII": {"t_ref": -0.001}}, r"t_ref must be a finite number in \[0, 0.1\] \(s\), got -0.001"),
+    ({"RAII": {"t_ref": 2.0}}, r"t_ref must be a finite number in \[0, 0.1\] \(s\), got 2"),
     ({"XX": {"a": 0.1}}, "neuron.XX: unknown afferent type"),
 ])
 def test_bad_tables_are_named(table, match):

@@ -6,7 +6,7 @@ Design (measured on this machine kind, see docs/user-guide.md, "Engines"):
   shape ``(n_neurons, n_samples)`` plus dt, substeps and method, compiled
   once and cached on disk (``$DDMM_CACHE_DIR/brian2/<key>``, default
   ``~/.cache/ddmm``).  Calls that change only input values re-run the same
-  binary: the initial v and u and the per-neuron a, b, c, d with Brian2's
+  binary: the initial v, u and r and the per-neuron a, b, c, d, n_ref with Brian2's
   ``run_args``, and the current table (a file the binary maps, named in
   its environment), so nothing recompiles.  A one-line notice is printed
   whenever a shape is compiled.
@@ -21,7 +21,7 @@ Design (measured on this machine kind, see docs/user-guide.md, "Engines"):
   and `ddmm.models.engines.direct` mirrors the generated expressions.
 * **Padding is exact.**  Extra neurons get zero current and are dropped;
   extra samples come after the end and their spikes are dropped.  The state
-  at the true end is captured in ``v_end, u_end`` by the same operation when
+  at the true end is captured in ``v_end, u_end, r_end`` by the same operation when
   ``t`` reaches ``t_end`` (a run argument), before the padded steps run.
 * **Lanes: runs in parallel.**  The binary is run directly (as Brian2's
   ``device.run`` does, but without changing the process's working
@@ -51,12 +51,12 @@ import numpy as np
 
 from ddmm.models._cache import cache_root
 from ddmm.models.engines.brian2.lanes import lane, write_table
-from ddmm.models.neuron import V_FLOOR
+from ddmm.models.neuron import V_FLOOR, refractory_steps
 
 __all__ = ["run_brian2", "cache_dir", "Brian2Warning"]
 
 _COMPILE_ARGS = ["-w", "-O3", "-ffp-contract=off", "-march=native", "-std=c++11"]
-_TEMPLATE_VERSION = "4"  # bump when the generated network changes
+_TEMPLATE_VERSION = "5"  # bump when the generated network changes
 _NEURON_QUANTUM = 32  # neuron padding granularity
 _SAMPLE_QUANTUM = 250  # sample padding granularity
 _MAX_ELEMENTS = 1 << 25  # current table elements per run: 256 MB
@@ -85,12 +85,22 @@ _VARIABLES = """
 I_in : 1
 v_end : 1
 u_end : 1
+r_end : 1
 t_end : second (shared)
 a : 1
 b : 1
 c : 1
 d : 1
+r : 1
+n_ref : 1
 """
+# The absolute refractory period (`NeuronParams.t_ref`): after the update and
+# the floor, a neuron with steps left keeps v at c and counts down.  The
+# selection by products with 0 and 1 is exact for finite values, so v is the
+# direct engine's (which branches) bit for bit.
+_REFRACTORY = """_free = int(r < 0.5)
+v = _free*v + (1 - _free)*c
+r = clip(r - 1, 0, inf)"""
 
 
 def cache_dir() -> Path:
@@ -127,7 +137,7 @@ def _key_dir(key: tuple) -> Path:
     ours = [p.read_bytes() for p in sorted((Path(__file__).parent / "templates").glob("*.cpp"))]
     ours += [device._INPUT_CPP, device._PER_STEP, device._AFTER_LOOP, device._ONCE]
     text = repr((key, brian2.__version__, _COMPILE_ARGS, _TEMPLATE_VERSION, _ODE, _VARIABLES, _IZHIKEVICH_2003,
-                 _EULER_FLOORED, ours))
+                 _EULER_FLOORED, _REFRACTORY, ours))
     digest = hashlib.sha256(text.encode()).hexdigest()[:16]
     n_neurons, n_samples, substeps, dt, method = key
     return cache_dir() / f"n{n_neurons}_t{n_samples}_s{substeps}_{method}_{digest}"
@@ -225,7 +235,7 @@ def _build(key: tuple) -> _Build:
         ddmm_input = input_function(n_samples, n_neurons, fs)
         explicit = method in ("izhikevich2003", "euler")
         group = b2.NeuronGroup(
-            n_neurons, (_STATE if explicit else _ODE) + _VARIABLES, threshold="v >= 30", reset="v = c; u += d",
+            n_neurons, (_STATE if explicit else _ODE) + _VARIABLES, threshold="v >= 30", reset="v = c; u += d; r = n_ref",
             method=None if explicit else method, dt=dt * b2.second, name="afferents", namespace={"ms": b2.ms},
         )
         if method == "euler":
@@ -234,17 +244,20 @@ def _build(key: tuple) -> _Build:
             if explicit:
                 group.run_regularly(_IZHIKEVICH_2003, when="groups", name="afferents_izhikevich2003")
             group.run_regularly(f"v = clip(v, {V_FLOOR!r}, inf)", when="before_thresholds", name="afferents_floor")
+        group.run_regularly(_REFRACTORY, when="before_thresholds", order=1, name="afferents_refractory")
         # Hold the current for one sample; when t reaches t_end (the end of the
         # real input) copy the state, which later padded steps then overwrite.
         code = (
             "I_in = ddmm_input(t, i)\n"
             f"at_end = int(abs(t - t_end) < {0.5 / fs!r}*second)\n"
             "v_end = at_end*v + (1 - at_end)*v_end\n"
-            "u_end = at_end*u + (1 - at_end)*u_end"
+            "u_end = at_end*u + (1 - at_end)*u_end\n"
+            "r_end = at_end*r + (1 - at_end)*r_end"
         )
         group.run_regularly(code, dt=(1.0 / fs) * b2.second, when="start")
         for var, value in (("a", 0.02), ("b", 0.2), ("c", -65.0), ("d", 8.0), ("v", -70.0),
-                           ("u", -14.0), ("v_end", -70.0), ("u_end", -14.0)):
+                           ("u", -14.0), ("v_end", -70.0), ("u_end", -14.0), ("r", 0.0), ("n_ref", 0.0),
+                           ("r_end", 0.0)):
             setattr(group, var, value)
         group.t_end = n_samples * substeps * dt * b2.second
         monitor = b2.SpikeMonitor(group, name="spikes")
@@ -253,7 +266,7 @@ def _build(key: tuple) -> _Build:
         standalone.build(directory=str(directory), run=False, with_output=False)
         b2.set_device("runtime")  # leave the user's Brian2 in its default mode
         results = {name: standalone.get_array_filename(owner.variables[name])
-                   for owner, names in ((group, ("v", "u", "v_end", "u_end")), (monitor, ("i", "t")))
+                   for owner, names in ((group, ("v", "u", "r", "v_end", "u_end", "r_end")), (monitor, ("i", "t")))
                    for name in names}
     return _Build(key, directory, n_neurons, n_samples, results)
 
@@ -281,12 +294,14 @@ def _run_binary(build: _Build, lane: Path, table: Path, run_args: list) -> Path:
     return results
 
 
-def _run_chunk(build: _Build, lane: Path, current, params, v, u):
+def _run_chunk(build: _Build, lane: Path, current, params, v, u, r):
     """Run the compiled binary once on a padded chunk; return spikes and final state."""
     n_real = current.shape[1]
     files = {}
-    for name, arr, fill in (("v", v, -70.0), ("u", u, -14.0), ("a", params["a"], 0.02),
-                            ("b", params["b"], 0.2), ("c", params["c"], -65.0), ("d", params["d"], 8.0)):
+    n_ref = refractory_steps(params["t_ref"], build.key[3])
+    for name, arr, fill in (("v", v, -70.0), ("u", u, -14.0), ("r", r, 0.0), ("a", params["a"], 0.02),
+                            ("b", params["b"], 0.2), ("c", params["c"], -65.0), ("d", params["d"], 8.0),
+                            ("n_ref", n_ref, 0.0)):
         full = np.full(build.n_neurons, fill)
         full[:n_real] = arr
         files[f"afferents.{name}"] = full
@@ -305,23 +320,26 @@ def _run_chunk(build: _Build, lane: Path, current, params, v, u):
     step = np.rint(read["t"] / build.key[3]).astype(np.int64)
     keep = neuron < n_real
     padded_tail = current.shape[0] < build.n_samples
-    v_name, u_name = ("v_end", "u_end") if padded_tail else ("v", "u")
-    return neuron[keep], step[keep], read[v_name][:n_real], read[u_name][:n_real]
+    names = ("v_end", "u_end", "r_end") if padded_tail else ("v", "u", "r")
+    return (neuron[keep], step[keep], *(read[name][:n_real] for name in names))
 
 
-def run_brian2(current, substeps, dt, params, v, u, method="euler", v_peak=30.0, v_floor=V_FLOOR):
+def run_brian2(current, substeps, dt, params, v, u, r=None, method="euler", v_peak=30.0, v_floor=V_FLOOR):
     """Integrate eqs 4-6 for N neurons with Brian2 (same contract as `run_direct`).
 
-    ``v`` and ``u`` are updated in place to the final state.  Returns
-    ``(neuron, step)`` int64 arrays sorted by step then neuron.
+    ``v``, ``u`` and ``r`` (refractory steps left; None: zeros) are updated
+    in place to the final state.  Returns ``(neuron, step)`` int64 arrays
+    sorted by step then neuron.
     """
     if v_peak != 30.0 or v_floor != V_FLOOR:
         raise ValueError(f"the Brian2 engine is built for v_peak = 30 and v_floor = {V_FLOOR} mV")
+    r = np.zeros(current.shape[1]) if r is None else r
+    params = params if "t_ref" in params else {**params, "t_ref": np.zeros(current.shape[1])}
     with lane() as path:
-        return _run_lanes(path, current, substeps, dt, params, v, u, method)
+        return _run_lanes(path, current, substeps, dt, params, v, u, r, method)
 
 
-def _run_lanes(lane, current, substeps, dt, params, v, u, method):
+def _run_lanes(lane, current, substeps, dt, params, v, u, r, method):
     n_samples_total, n_neurons = current.shape
     n_pad = _pad(n_neurons, _NEURON_QUANTUM)
     chunk = max(_SAMPLE_QUANTUM, (_MAX_ELEMENTS // n_pad) // _SAMPLE_QUANTUM * _SAMPLE_QUANTUM)
@@ -330,12 +348,12 @@ def _run_lanes(lane, current, substeps, dt, params, v, u, method):
     neurons, steps = [], []
     for start in range(0, n_samples_total, t_pad):
         part = current[start : start + t_pad]
-        nrn, stp, v_new, u_new = _run_chunk(build, lane, part, params, v, u)
+        nrn, stp, v_new, u_new, r_new = _run_chunk(build, lane, part, params, v, u, r)
         n_valid = part.shape[0] * substeps
         keep = stp < n_valid  # spikes in the zero padding after the end are not real
         neurons.append(nrn[keep])
         steps.append(stp[keep] + start * substeps)
-        v[:], u[:] = v_new, u_new
+        v[:], u[:], r[:] = v_new, u_new, r_new
     neuron = np.concatenate(neurons)
     step = np.concatenate(steps)
     key = step * (n_neurons + 1) + neuron
