@@ -6,6 +6,7 @@ import time
 import warnings
 from pathlib import Path
 
+from ddmm.experiments.cmd_recordings import add_recording_options, csv_scene
 from ddmm.experiments.io import ensure_out_dir, save_figure
 from ddmm.population.io.arrays import EXTENSIONS
 
@@ -40,6 +41,7 @@ def _add_run_options(p, *, out_required: bool) -> None:
     p.add_argument("--scheduler", default=None, metavar="processes|ADDRESS",
                    help="run afferent blocks on Dask: a local pool of processes or a scheduler address")
     p.add_argument("--out", required=out_required, metavar="FILE.nc")
+    add_recording_options(p)
 
 
 def register(sub) -> None:
@@ -104,7 +106,7 @@ def _array_scene(args):
 
 def scenes_from_args(args) -> list:
     """The scenes named by ``--scene``, ``--sites``, ``--theta-r`` and ``--contact``."""
-    from ddmm.population import birznieks, from_csv, press_push_lift, rotating_shear
+    from ddmm.population import birznieks, press_push_lift, rotating_shear
     array = _array_scene(args)
     if array is not None:
         return [array]
@@ -119,8 +121,8 @@ def scenes_from_args(args) -> list:
     if args.scene == "rotating-shear":
         start = _directions(args.theta_r, default="0")
         return [rotating_shear(start_deg=start[0] or 0.0, contact=contact)]
-    if args.scene.endswith(".csv"):
-        return [from_csv(args.scene, contact=contact)]
+    if args.scene.lower().endswith(".csv"):
+        return [csv_scene(args.scene, args, contact)]
     raise ValueError(f"--scene {args.scene!r} is unknown; allowed: {', '.join(SCENES)}, a .csv file or a "
                      f"sensor-array file ({', '.join(EXTENSIONS)})")
 

@@ -46,11 +46,14 @@ def check_fs(fs: float, params: CurrentParams, types=AFFERENT_TYPES) -> None:
         stage = params.stage(kind)
         if stage.cutoff_hz is None:
             continue
-        need = RAII_FS_FACTOR * stage.cutoff_hz if kind == "RAII" else 2.0 * stage.cutoff_hz
-        if fs < need or stage.cutoff_hz >= fs / 2.0:
+        if kind == "RAII":
+            too_slow, need = fs < RAII_FS_FACTOR * stage.cutoff_hz, f"at >= {RAII_FS_FACTOR * stage.cutoff_hz:g} Hz"
+        else:  # a cut-off at or above Nyquist is no filter
+            too_slow, need = stage.cutoff_hz >= fs / 2.0, f"faster than {2.0 * stage.cutoff_hz:g} Hz"
+        if too_slow or stage.cutoff_hz >= fs / 2.0:
             raise ValueError(
                 f"fs={fs:g} Hz is too slow for {kind}: its band reaches {stage.cutoff_hz:g} Hz, which needs force "
-                f"sampled at >= {need:g} Hz; resample the scene faster or leave {kind} out (types=...)"
+                f"sampled {need}; resample the scene faster (from_csv(fs=...)) or leave {kind} out (types=...)"
             )
 
 

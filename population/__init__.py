@@ -32,8 +32,10 @@ _WHERE = {
     "runtime.plan": ("make_plan",),
     "runtime.stream": ("Encoder",),
     "sampling": ("Population", "make_population", "sample_population"),
-    "stimuli.scenes": ("Contact", "Scene", "Sites", "Stage", "birznieks", "from_csv", "press_push_lift",
+    "stimuli.scenes": ("Contact", "Scene", "Sites", "Stage", "birznieks", "press_push_lift",
                        "rotating_shear", "taxel_radius"),
+    "stimuli.recordings": ("from_csv", "RecordingBandWarning"),
+    "stimuli.conditioning": ("Conditioning", "condition_forces"),
     "simulation": ("plan_run", "simulate"),
     "spec": ("PopulationSpec", "load_spec", "spec_from_dict"),
 }

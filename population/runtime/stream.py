@@ -27,7 +27,8 @@ from ddmm.population.anatomy.receptive_fields import population_weight, site_cov
 from ddmm.population.runtime.noise import noise_key, root_seed
 from ddmm.population.sampling import Population
 from ddmm.population.simulation import _grouped, block_pipeline
-from ddmm.population.stimuli.scenes import Contact, Sites
+from ddmm.population.stimuli.conditioning import Conditioner, Conditioning, noise_allowance
+from ddmm.population.stimuli.scenes import DEFAULT_FS, Contact, Sites
 
 __all__ = ["StreamSpikes", "Encoder"]
 
@@ -73,6 +74,20 @@ class Encoder:
         The force sites of a sensor array or multi-digit hand: chunks are
         then (n, n_sites, 3), and each afferent feels its own local force
         (`ddmm.population.anatomy.receptive_fields`), as `simulate` does for `Scene.from_sites`.
+    types : sequence of str, optional
+        Afferent types to simulate (as `simulate`'s ``types``); the others
+        never spike.  A sensor too slow for FA-II leaves them out this way.
+    conditioning : Conditioning, optional
+        For a live sensor: pushed samples (at ``fs``) pass through the causal
+        conditioning stage (`ddmm.population.stimuli.conditioning`), which
+        brings them to ``model_fs``; the spikes then equal an offline
+        `from_csv` of the same samples with the same conditioning, bit for
+        bit.  None (default): forces are taken as they are, as `simulate`
+        takes a `Scene` (the stage costs ~0.17 ms a push, more than a
+        fingertip push's integration; ``ddmm stream`` switches it on).
+    model_fs : float, optional
+        The model's sample rate with ``conditioning`` (default 1000 Hz, the
+        rate `from_csv` gives); without it the model runs at ``fs``.
 
     Notes
     -----
@@ -90,11 +105,14 @@ class Encoder:
     """
 
     def __init__(self, population, fs: float, *, dt: float = 1e-4, engine: str = "direct", method: str = "euler",
-                 seed=None, no_shear: str = "smooth", contact: Contact | None = None, sites: Sites | None = None):
+                 seed=None, no_shear: str = "smooth", contact: Contact | None = None, sites: Sites | None = None,
+                 types=None, conditioning: Conditioning | None = None, model_fs: float | None = None):
         if not isinstance(population, Population):
             raise TypeError(f"population must be a Population, got {type(population).__name__}")
         self.fs = check_positive(fs, "fs", "Hz")
-        self.substeps = substeps_for(self.fs, dt)
+        self.conditioning = conditioning
+        self.model_fs = self._model_fs(conditioning, model_fs)
+        self.substeps = substeps_for(self.model_fs, dt)
         self.dt, self._engine = float(dt), get_engine(engine)
         self.engine = self._engine.name
         self.method = check_choice(method, "method", METHODS)
@@ -106,9 +124,9 @@ class Encoder:
                             f"{type(sites).__name__} with contact={contact!r}")
         self.seed, self.contact = root_seed(seed), contact
         self.sites = sites
-        check_fs(self.fs, population.current, tuple(np.unique(population.afferent_type)))
-        idx = np.arange(len(population))
-        self._order = _grouped(population, idx, idx)  # contiguous (type, NAP) groups, as offline
+        idx = _type_positions(population, types)
+        check_fs(self.model_fs, population.current, tuple(np.unique(population.afferent_type[idx])))
+        self._order = idx[_grouped(population, idx, np.arange(idx.size))]  # contiguous (type, NAP) groups, as offline
         self._pop = population.select(self._order)
         self._precompute()
         self._engine.prepare()
@@ -122,7 +140,7 @@ class Encoder:
             scale = pop.gain * population_weight(pop, self.contact)
         elif self.sites is not None:
             scale = pop.gain * site_coverage(pop, self.sites)
-        self._pipeline = block_pipeline(pop, self.fs, self.sites, scale, self.no_shear)
+        self._pipeline = block_pipeline(pop, self.model_fs, self.sites, scale, self.no_shear)
         # Read once: a push is latency-bound, and the thread count is fixed for the encoder's life.
         self._parts = self._engine.stream_parts(len(pop))
         noisy = np.any(pop.noise_sigma > 0) or np.any(pop.noise_cv > 0) or self._pipeline.excite_any
@@ -131,13 +149,25 @@ class Encoder:
     def reset(self) -> None:
         """Back to the start: filters at rest on the next sample, neurons at rest, noise from sample 0."""
         self._state, self._neuron, self._samples, self._last_time = self._pipeline.new_state(), None, 0, None
+        self._conditioner = None if self.conditioning is None else Conditioner(
+            self.conditioning, self.fs, self.model_fs, None if self.sites is None else len(self.sites))
+
+    def _model_fs(self, conditioning, model_fs) -> float:
+        if conditioning is None:
+            if model_fs is not None:
+                raise ValueError("model_fs goes with a conditioning: without one the model runs at fs")
+            return self.fs
+        if not isinstance(conditioning, Conditioning) or conditioning.mode != "causal":
+            raise ValueError(f"conditioning must be a causal Conditioning (a stream cannot look ahead), "
+                             f"got {conditioning!r}")
+        return DEFAULT_FS if model_fs is None else check_positive(model_fs, "model_fs", "Hz")
 
     def wait_ready(self) -> None:
         """Nothing to prepare: noise is drawn on demand (kept so real-time loops written for it still run)."""
 
     @property
     def n_samples(self) -> int:
-        """Samples consumed since the start (or the last reset)."""
+        """Model samples (at ``model_fs``) consumed since the start (or the last reset)."""
         return self._samples
 
     def _validate(self, forces, times):
@@ -148,8 +178,11 @@ class Encoder:
                                  f"encoder's sites, got {forces.shape}")
         elif forces.ndim != 2 or forces.shape[1] != 3:
             raise ValueError(f"forces must have shape (n, 3) for (fx, fy, fz), got {forces.shape}")
-        if np.any(forces[..., 2] < 0):
-            raise ValueError("forces: the normal force fz must be >= 0 N")
+        allowance = 0.0 if self.conditioning is None else noise_allowance(self.conditioning)
+        if forces.size and float(forces[..., 2].min()) < -allowance:
+            raise ValueError(f"forces: the normal force fz must be >= {-allowance:g} N, got "
+                             f"{float(forces[..., 2].min()):g}" + (" (a live sensor's noise and offset: give the "
+                             "encoder a conditioning)" if self.conditioning is None else " (check the sign convention)"))
         if times is not None:
             times = as_finite_array(times, "times", ndim=1)
             if times.size != forces.shape[0]:
@@ -165,7 +198,8 @@ class Encoder:
         Parameters
         ----------
         forces : array_like, shape (n, 3)
-            F_X, F_Y, F_Z in newtons, one row per sample at ``fs``.
+            F_X, F_Y, F_Z in newtons, one row per sample at ``fs`` (with a
+            conditioning, the sensor's raw samples).
         times : array_like, shape (n,), optional
             Sample times in seconds, checked to increase strictly across
             chunks (the encoder's clock is the sample count, not these).
@@ -177,6 +211,8 @@ class Encoder:
             time going backwards; the encoder's state is left untouched.
         """
         forces, times = self._validate(forces, times)
+        if self._conditioner is not None:
+            forces, _ = self._conditioner.push(forces)  # may hold back nothing: it is causal, sample by sample
         n = forces.shape[0]
         if n == 0:
             return StreamSpikes(np.empty(0, np.int64), np.empty(0))
@@ -193,3 +229,16 @@ class Encoder:
             order = np.lexsort((afferent, step))
             afferent, step = afferent[order], step[order]
         return StreamSpikes(afferent, step * self.dt)
+
+
+def _type_positions(population, types) -> np.ndarray:
+    """Positions of the afferents of ``types`` (all when None), checked as `simulate` checks them."""
+    if types is None:
+        return np.arange(len(population))
+    from ddmm.models.afferent_types import normalize_type
+
+    codes = {normalize_type(t) for t in ([types] if isinstance(types, str) else types)}
+    idx = np.flatnonzero(np.isin(population.afferent_type, sorted(codes)))
+    if idx.size == 0:
+        raise ValueError(f"types={sorted(codes)} selects no afferent of this population")
+    return idx

@@ -1,15 +1,21 @@
 """Stimuli: the forces a population feels.
 
 - `scenes`: three-axis fingertip force on a uniform time base (`Scene`), the
-  paper's protocols, CSV recordings, contacts and force sites;
+  paper's protocols, contacts and force sites;
+- `recordings`: scenes from recorded force files (`from_csv`: columns, units,
+  sign, time base, negative force);
+- `conditioning`: the stage between a recording and the model (resampling,
+  noise gate, contact and shear deadband), offline and streaming;
 - `site_scenes`: scenes only force fields can express (torsion, slip, grasp).
 """
 
 from ddmm.models._lazy import lazy_exports
 
 _WHERE = {
-    "scenes": ("DEFAULT_FS", "Contact", "Scene", "Sites", "Stage", "birznieks", "from_csv", "press_push_lift",
+    "scenes": ("DEFAULT_FS", "Contact", "Scene", "Sites", "Stage", "birznieks", "press_push_lift",
                "rotating_shear", "taxel_radius"),
+    "recordings": ("from_csv", "RecordingBandWarning", "UNITS"),
+    "conditioning": ("Conditioning", "Conditioner", "condition_forces"),
     "site_scenes": ("contact_grid", "grasp", "incipient_slip", "torsion"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

@@ -55,10 +55,10 @@ BAD_SPECS = [
     ('[types.SAI]\ncount = 3\ntheta_t = { distribution = "zipf" }\n', "zipf"),
 ]
 BAD_SCENES = [
-    ("time,fx,fy,fz\n0,0,0,1\n0,0,0,1\n", "increasing"),
-    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,nan,1\n", "non-finite"),
-    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,0,-1\n", "negative normal force"),
-    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,0\n", "unequal length"),
+    ("time,fx,fy,fz\n0,0,0,1\n0,0,0,1\n", "increase strictly"),
+    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,nan,1\n", "'nan' is not finite"),
+    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,0,-1\n", "normal force down to -1 N (line 3)"),
+    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,0\n", "line 3 has 3 values but the header has 4"),
     ("", "empty"),
     ("time,fx,fz\n0,0,1\n", "'fy'"),
 ]

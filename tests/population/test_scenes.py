@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from ddmm.population.stimuli.scenes import Contact, Scene, birznieks, from_csv, press_push_lift, rotating_shear
+from ddmm.population.stimuli.recordings import from_csv
+from ddmm.population.stimuli.scenes import Contact, Scene, birznieks, press_push_lift, rotating_shear
 
 
 def test_birznieks():
@@ -47,25 +48,25 @@ def write(tmp_path, text, name="f.csv"):
     return path
 
 
-def test_csv_resamples_100hz(tmp_path):
+def test_csv_resamples_100hz_without_conditioning(tmp_path):
     t = np.arange(0, 1.0, 0.01)
     rows = "\n".join(f"{a:.2f},{0.0},{0.5 * a},{2 * a}" for a in t)
-    s = from_csv(write(tmp_path, "time,fx,fy,fz\n" + rows))
+    s = from_csv(write(tmp_path, "time,fx,fy,fz\n" + rows), conditioning=None)
     assert s.fs == 1000.0 and s.n_samples == 991
     np.testing.assert_allclose(s.fz, 2 * s.time, atol=1e-12)
 
 
 def test_csv_column_mapping_and_units(tmp_path):
-    s = from_csv(write(tmp_path, "t_ms,Fx,Fy,Fz\n0,0,0,1\n10,0,0,2\n"),
+    s = from_csv(write(tmp_path, "t_ms,Fx,Fy,Fz\n0,0,0,1\n10,0,0,2\n"), conditioning=None,
                  columns={"time": "t_ms", "fx": "Fx", "fy": "Fy", "fz": "Fz"}, time_scale=1e-3)
     assert s.n_samples == 11 and s.fz[-1] == 2.0
 
 
 @pytest.mark.parametrize("text,match", [
-    ("time,fx,fy,fz\n0,0,0,1\n0,0,0,1\n", "strictly increasing"),
-    ("time,fx,fy,fz\n0,0,0,1\n0.01,nan,0,1\n", "non-finite"),
-    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,0,-2\n", "negative normal force"),
-    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,0\n", "unequal length"),
+    ("time,fx,fy,fz\n0,0,0,1\n0,0,0,1\n", "time must increase strictly"),
+    ("time,fx,fy,fz\n0,0,0,1\n0.01,nan,0,1\n", "not finite"),
+    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,0,-2\n", r"normal force down to -2 N \(line 3\)"),
+    ("time,fx,fy,fz\n0,0,0,1\n0.01,0,0\n", "line 3 has 3 values but the header has 4"),
     ("", "empty"),
     ("time,fx,fy\n0,0,0\n", "no column 'fz'"),
     ("time,fx,fy,fz\n", "no data rows"),
@@ -77,5 +78,5 @@ def test_csv_errors(tmp_path, text, match):
 
 
 def test_csv_negative_fz_can_be_clipped(tmp_path):
-    s = from_csv(write(tmp_path, "time,fx,fy,fz\n0,0,0,-0.01\n0.01,0,0,1\n"), negative_fz="clip")
+    s = from_csv(write(tmp_path, "time,fx,fy,fz\n0,0,0,-0.01\n0.01,0,0,1\n"), negative_fz="clip", conditioning=None)
     assert s.fz.min() == 0.0

@@ -122,3 +122,46 @@ def test_the_spike_cap_warning_survives_the_fused_path():
     with warnings.catch_warnings():
         warnings.simplefilter("error", SpikeCapWarning)
         Encoder(make_population(["SAI"]), scene.fs, seed=0).push(np.column_stack([scene.fx, scene.fy, scene.fz]))
+
+
+@settings(max_examples=6, deadline=None)
+@given(cuts=st.lists(st.integers(1, 299), max_size=12, unique=True))
+def test_a_100_hz_sensor_streams_and_equals_the_offline_file_in_the_causal_mode(tmp_path_factory, cuts):
+    """Raw 100 Hz samples with sensor noise: the encoder's causal conditioning and types equal `from_csv`
+    (same conditioning) and `simulate(types=...)`, bit for bit, for any chunking."""
+    from ddmm.population import from_csv
+    from ddmm.population.stimuli.conditioning import Conditioning
+
+    rng = np.random.default_rng(5)
+    t = np.arange(300) / 100.0
+    f = np.column_stack([rng.normal(0, 0.02, 300), np.interp(t, [0, 1, 2, 3], [0, 0, 1, 1]),
+                         np.interp(t, [0, 0.5, 1, 3], [0, 0, 3, 3])]) + [0, 0, 1] * rng.normal(0, 0.02, (300, 3))
+    path = tmp_path_factory.mktemp("plate") / "plate.csv"
+    path.write_text("Time,Fx,Fy,Fz\n" + "".join(f"{a:.2f},{float(b)!r},{float(c)!r},{float(d)!r}\n" for a, (b, c, d) in zip(t, f)))
+    pop = sample_population("fingertip", rng=0).select(np.arange(0, 991, 9))
+    types = ("SAI", "RAI", "SAII")
+    with pytest.warns(UserWarning, match="FA-II's band"):
+        scene = from_csv(path)
+    offline = simulate(pop, scene, engine="direct", seed=3, types=types, quiet=True)
+    enc = Encoder(pop, 100.0, seed=3, types=types, conditioning=Conditioning(), model_fs=1000.0)
+    edges = [0] + sorted(cuts) + [300]
+    aff, times = concat([enc.push(f[a:b]) for a, b in zip(edges[:-1], edges[1:])])
+    ids = offline.afferent.values[offline.spike_afferent.values]
+    np.testing.assert_array_equal(pop.afferent_id[aff], ids)
+    np.testing.assert_array_equal(times, offline.spike_time.values)
+    assert aff.size > 100 and set(pop.afferent_type[aff]) <= set(types)
+
+
+def test_cli_stream_at_100_hz_with_types_and_a_gap(capsys, monkeypatch):
+    import io
+
+    from ddmm.experiments.cli import main
+    t = np.r_[np.arange(0, 1.0, 0.01), np.arange(1.2, 2.0, 0.01)]
+    fz = -np.interp(t, [0, 0.3, 2], [0, 3, 3])  # a plate that reports pressing as negative
+    lines = ["Time,Fx,Fy,Fz"] + [f"{a:.3f},0,0,{b:.4f}" for a, b in zip(t, fz)]
+    monkeypatch.setattr("sys.stdin", io.StringIO("\n".join(lines) + "\n"))
+    assert main(["stream", "--fs", "100", "--types", "SAI,RAI", "--fz-sign", "-1", "--seed", "2"]) == 0
+    out, err = capsys.readouterr()
+    rows = [r.split(",") for r in out.strip().splitlines()]
+    assert len(rows) > 50 and {r[2] for r in rows} == {"SAI", "RAI"}
+    assert "line 102: a gap of 0.21 s at t = 0.99 s" in err and "skipped" not in err

@@ -1,0 +1,74 @@
+"""Command-line options for recorded forces, shared by ``ddmm simulate``/``plan`` (a ``--scene FILE.csv``) and
+``ddmm stream`` (samples on stdin): columns, units, sign, time base, negative force and the conditioning stage."""
+
+from __future__ import annotations
+
+__all__ = ["add_recording_options", "conditioning_from_args", "csv_scene"]
+
+_FIELDS = ("time", "fx", "fy", "fz")
+
+
+def add_recording_options(p, *, stream: bool = False) -> None:
+    """Add the recording options to a subcommand's parser (the file-only ones unless ``stream``)."""
+    from ddmm.population.stimuli.recordings import GAPS, NEGATIVE_FZ, UNITS
+
+    g = p.add_argument_group("recorded forces" + ("" if stream else " (--scene FILE.csv)"))
+    if not stream:
+        g.add_argument("--columns", default=None, metavar="time=COL,fx=COL,...",
+                       help="the file's column for each of time, fx, fy, fz (headers match in any case)")
+        g.add_argument("--fs", type=float, default=None, metavar="HZ",
+                       help="sample rate of a file without a time column")
+        g.add_argument("--time-scale", type=float, default=1.0, metavar="S",
+                       help="the time column's unit in seconds (0.001 for ms)")
+        g.add_argument("--negative-fz", choices=NEGATIVE_FZ, default="error",
+                       help="a negative normal force beyond sensor noise: an error (default), clipped, or the "
+                            "first 0.1 s taken as the sensor's zero offset")
+        g.add_argument("--gaps", choices=GAPS, default="error", help="gaps in the time column: refused or filled")
+    g.add_argument("--units", choices=tuple(UNITS), default="N", help="force unit of the input (default N)")
+    g.add_argument("--fz-sign", type=int, choices=(1, -1), default=1,
+                   help="-1 for a sensor that reports pressing as negative F_Z")
+    g.add_argument("--conditioning", choices=("causal", "zero_phase", "off"), default="causal",
+                   help="the conditioning stage between the recording and the model (default causal; "
+                        "zero_phase offline only; docs/recordings.md)")
+    g.add_argument("--sensor-noise", type=float, default=None, metavar="N",
+                   help="the sensor's noise SD in newtons: the fast band is gated at 4x it (default 0.02; 0: off)")
+    g.add_argument("--bandwidth", type=float, default=None, metavar="HZ", help="the sensor's bandwidth in Hz")
+
+
+def conditioning_from_args(args):
+    """The `Conditioning` the options name, or None for ``--conditioning off``."""
+    from ddmm.population.stimuli.conditioning import Conditioning
+
+    if args.conditioning == "off":
+        if args.sensor_noise is not None or args.bandwidth is not None:
+            raise ValueError("--sensor-noise and --bandwidth set the conditioning, which --conditioning off "
+                             "switches off")
+        return None
+    settings = {"mode": args.conditioning}
+    if args.sensor_noise is not None:
+        settings["noise_n"] = args.sensor_noise
+    if args.bandwidth is not None:
+        settings["bandwidth_hz"] = args.bandwidth
+    return Conditioning(**settings)
+
+
+def _columns(text):
+    if text is None:
+        return None
+    out = {}
+    for part in text.split(","):
+        key, sep, value = part.partition("=")
+        key = key.strip().lower()
+        if not sep or key not in _FIELDS or not value.strip():
+            raise ValueError(f"--columns: {part.strip()!r} is not NAME=COLUMN with NAME one of {', '.join(_FIELDS)}")
+        out[key] = value.strip()
+    return out
+
+
+def csv_scene(path, args, contact):
+    """The scene of a recorded force file, read with the options of `add_recording_options`."""
+    from ddmm.population.stimuli.recordings import from_csv
+
+    return from_csv(path, columns=_columns(args.columns), recorded_fs=args.fs, time_scale=args.time_scale,
+                    units=args.units, fz_sign=args.fz_sign, negative_fz=args.negative_fz, gaps=args.gaps,
+                    conditioning=conditioning_from_args(args), contact=contact)

@@ -1,0 +1,244 @@
+"""Scenes from real force recordings: CSV files of any sensor, at any sample rate.
+
+`from_csv` reads a file's columns (matched case-insensitively, mapped with
+``columns``), converts units and the sign convention, checks the time base
+(strictly increasing; gaps refused unless ``gaps="interpolate"``), handles a
+negative normal force (an error, clipped, or an offset removed from a quiet
+baseline) and hands the recording to the conditioning stage
+(`ddmm.population.stimuli.conditioning`), which is on by default here and
+brings it to the model's sample rate.  Every message names the file, the
+column or line, and shows plain numbers.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ddmm.models._validation import check_positive
+from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
+from ddmm.population.stimuli.scenes import DEFAULT_FS, Contact, Scene
+
+__all__ = ["from_csv", "UNITS", "RECORDED", "RecordingBandWarning", "NEGATIVE_FZ", "GAPS", "FA_II_MIN_FS"]
+
+#: Force units a file may be in, and their value in newtons.
+UNITS = {"N": 1.0, "mN": 1e-3, "gf": 9.80665e-3, "kgf": 9.80665, "lbf": 4.4482216152605}
+#: The conditioning `from_csv` applies unless told otherwise.
+RECORDED = Conditioning()
+NEGATIVE_FZ = ("error", "clip", "offset")
+GAPS = ("error", "interpolate")
+#: A recording slower than this cannot carry FA-II's band (up to 300 Hz, sampled at 2.5x).
+FA_II_MIN_FS = 750.0
+_FIELDS = ("time", "fx", "fy", "fz")
+_BASELINE_S = 0.1  # quiet baseline for negative_fz="offset"
+_GAP = 1.5  # an interval longer than this many times the median is a gap
+_JITTER = 0.01  # intervals within 1% of the median count as uniform
+
+
+class RecordingBandWarning(UserWarning):
+    """A recording's sample rate cannot carry a band a simulated type needs."""
+
+
+def _read(path, wanted: dict) -> tuple:
+    """(the mapped columns as float arrays, the file's header): header names matched case-insensitively."""
+    try:
+        with open(path, newline="") as fh:
+            rows = [row for row in csv.reader(fh) if row and any(cell.strip() for cell in row)]
+    except OSError as exc:
+        raise ValueError(f"scene file {str(path)!r} cannot be read: {exc.strerror}") from None
+    if not rows:
+        raise ValueError(f"scene file {str(path)!r} is empty")
+    header = [h.strip() for h in rows[0]]
+    lower = [h.lower() for h in header]
+    index = {}
+    for ours, theirs in wanted.items():
+        if theirs.lower() not in lower:
+            raise ValueError(f"scene file {str(path)!r} has no column {theirs!r} (for {ours}; matched "
+                             f"case-insensitively); header: {','.join(header)}")
+        index[ours] = lower.index(theirs.lower())
+    if len(rows) < 2:
+        raise ValueError(f"scene file {str(path)!r} has a header but no data rows")
+    out = {k: np.empty(len(rows) - 1) for k in wanted}
+    for r, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise ValueError(f"scene file {str(path)!r}: line {r} has {len(row)} values but the header has "
+                             f"{len(header)}")
+        for ours, i in index.items():
+            try:
+                out[ours][r - 2] = float(row[i])
+            except ValueError:
+                raise ValueError(f"scene file {str(path)!r}: column {header[i]!r}, line {r}: {row[i]!r} is not a "
+                                 "number") from None
+            if not math.isfinite(out[ours][r - 2]):
+                raise ValueError(f"scene file {str(path)!r}: column {header[i]!r}, line {r}: {row[i]!r} is not "
+                                 "finite")
+    return out, header
+
+
+def _mapping(columns, recorded_fs) -> dict:
+    mapping = {k: k for k in _FIELDS}
+    for key, value in (columns or {}).items():
+        if key not in mapping:
+            raise ValueError(f"columns: unknown key {key!r}; allowed: {', '.join(_FIELDS)}")
+        if not isinstance(value, str) or not value.strip():
+            raise ValueError(f"columns: {key} must name a column, got {value!r}")
+        mapping[key] = value.strip()
+    if recorded_fs is not None:
+        if columns and "time" in columns:
+            raise ValueError("give recorded_fs or a time column, not both")
+        del mapping["time"]
+    return mapping
+
+
+def _uniform(path, t, data: dict, gaps: str) -> tuple:
+    """(sample rate in Hz, the columns on a uniform grid): gaps refused or interpolated, jitter resampled."""
+    step = np.diff(t)
+    if np.any(step <= 0):
+        line = int(np.flatnonzero(step <= 0)[0]) + 3
+        raise ValueError(f"scene file {str(path)!r}: time must increase strictly (line {line}: "
+                         f"{float(t[line - 2]):g} s after {float(t[line - 3]):g} s)")
+    median = float(np.median(step))
+    gap = step > _GAP * median
+    if np.any(gap) and gaps == "error":
+        i = int(np.flatnonzero(gap)[0])
+        raise ValueError(f"scene file {str(path)!r}: a gap of {float(step[i]):g} s at t = {float(t[i]):g} s "
+                         f"(line {i + 2}; samples every {median:g} s); use gaps='interpolate' (--gaps interpolate) to fill it")
+    if not np.any(gap) and np.all(np.abs(step - median) <= _JITTER * median):
+        return 1.0 / median, data
+    grid = t[0] + np.arange(int(math.floor((t[-1] - t[0]) / median + 1e-9)) + 1) * median
+    return 1.0 / median, {k: np.interp(grid, t, v) for k, v in data.items()}
+
+
+def _negative(path, fz, forces, negative_fz, conditioning, fs_in):
+    """Apply the negative-F_Z rule; raise with plain numbers when a negative force is not noise."""
+    if negative_fz == "offset":
+        quiet = slice(0, max(1, int(round(_BASELINE_S * fs_in))))
+        forces = forces - np.median(forces[quiet], axis=0)
+        fz = forces[:, 2]
+    tolerance = 0.0 if conditioning is None else noise_allowance(conditioning)
+    if negative_fz == "clip" or fz.min() >= -tolerance:
+        forces[:, 2] = np.maximum(fz, -tolerance)
+        return forces
+    line = int(np.argmin(fz)) + 2
+    hint = (" and it is never positive: a plate that reports pressing as negative needs fz_sign=-1 (--fz-sign -1)"
+            if fz.max() <= tolerance else
+            "; for a sensor offset use negative_fz='offset' or 'clip' (--negative-fz offset|clip)")
+    raise ValueError(f"scene file {str(path)!r}: normal force down to {float(fz.min()):.4g} N (line {line}){hint}")
+
+
+def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recorded_fs: float | None = None,
+             time_scale: float = 1.0, units: str = "N", force_scale: float = 1.0, fz_sign: int = 1,
+             negative_fz: str = "error", gaps: str = "error", conditioning: Conditioning | None = RECORDED,
+             name: str | None = None, contact: Contact | None = None) -> Scene:
+    """A scene from a recorded force file (a force plate, a load cell, a fingertip sensor).
+
+    Parameters
+    ----------
+    path : str or Path
+        A CSV file with a header.  By default its columns are ``time, fx, fy,
+        fz`` (any case: ``Time,Fx,Fy,Fz`` reads as is).
+    columns : dict, optional
+        Our names (``time``, ``fx``, ``fy``, ``fz``) to the file's, e.g.
+        ``{"time": "t_ms", "fz": "Fz_N"}``.
+    fs : float
+        Sample rate of the scene (the model's), Hz.
+    recorded_fs : float, optional
+        The recording's sample rate, Hz, for a file without a time column.
+    time_scale : float
+        The time column's unit in seconds (1e-3 for milliseconds).
+    units : {"N", "mN", "gf", "kgf", "lbf"}
+        The force columns' unit; ``force_scale`` multiplies further.
+    fz_sign : {1, -1}
+        -1 for a plate that reports pressing as negative F_Z.
+    negative_fz : {"error", "clip", "offset"}
+        A negative normal force (beyond the conditioning's noise allowance)
+        is an error, clipped to 0, or (``"offset"``) the median of the first
+        0.1 s is taken off every axis first (a sensor's zero offset).
+    gaps : {"error", "interpolate"}
+        An interval longer than 1.5 times the median is refused, or filled by
+        linear interpolation.
+    conditioning : Conditioning or None
+        The conditioning stage (`ddmm.population.stimuli.conditioning`; on by
+        default for recordings).  None: the recording as it is, resampled by
+        monotone cubic interpolation.
+    name : str, optional
+        Condition name (default: the file stem).
+    contact : Contact, optional
+        Contact geometry.
+
+    Raises
+    ------
+    ValueError
+        Naming the file and the column, line or option of the first problem.
+
+    Warns
+    -----
+    RecordingBandWarning
+        When the recording is slower than 750 Hz: FA-II's band is missing.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "plate.csv"
+    >>> _ = path.write_text("Time,Fx,Fy,Fz\\n" + "".join(f"{k / 1000},0,0,{-min(k / 100, 2.0)}\\n"
+    ...                                                   for k in range(1000)))
+    >>> scene = from_csv(path, fz_sign=-1)
+    >>> scene.fs, round(float(scene.fz[-1]), 2)
+    (1000.0, 1.97)
+    """
+    _check_options(fs, units, fz_sign, negative_fz, gaps, conditioning)
+    mapping = _mapping(columns, recorded_fs)
+    data, header = _read(path, mapping)
+    if recorded_fs is not None:
+        if "time" in (h.lower() for h in header):
+            raise ValueError(f"scene file {str(path)!r} has a time column: give recorded_fs (--fs) only for a file "
+                             "without one")
+        fs_in = check_positive(recorded_fs, "recorded_fs", "Hz")
+    else:
+        t = data.pop("time") * check_positive(time_scale, "time_scale")
+        if t.size < 2:
+            raise ValueError(f"scene file {str(path)!r} needs at least 2 samples, got {t.size}")
+        fs_in, data = _uniform(path, t, data, gaps)
+    scale = UNITS[units] * check_positive(force_scale, "force_scale")
+    forces = np.column_stack([data["fx"] * scale, data["fy"] * scale, data["fz"] * scale * fz_sign])
+    forces = _negative(path, forces[:, 2], forces, negative_fz, conditioning, fs_in)
+    if fs_in < FA_II_MIN_FS:
+        warnings.warn(RecordingBandWarning(
+            f"{Path(path).name} is sampled at {fs_in:g} Hz and carries 0-{fs_in / 2:g} Hz: FA-II's band "
+            f"(120-300 Hz) is missing, so FA-II respond only to its ramps (leave them out with types=...)"),
+            stacklevel=2)
+    if conditioning is None:
+        out = _pchip(forces, fs_in, fs)
+    else:
+        out, _ = condition_forces(forces, fs_in, fs, conditioning)
+    return Scene(out[:, 0], out[:, 1], out[:, 2], fs=fs, name=name or Path(path).stem, contact=contact)
+
+
+def _check_options(fs, units, fz_sign, negative_fz, gaps, conditioning) -> None:
+    check_positive(fs, "fs", "Hz")
+    for value, name, allowed in ((units, "units", tuple(UNITS)), (negative_fz, "negative_fz", NEGATIVE_FZ),
+                                 (gaps, "gaps", GAPS)):
+        if value not in allowed:
+            raise ValueError(f"{name}={value!r} is not allowed; allowed: {', '.join(allowed)}")
+    if fz_sign not in (1, -1) or isinstance(fz_sign, bool):
+        raise ValueError(f"fz_sign must be 1 or -1, got {fz_sign!r}")
+    if conditioning is not None and not isinstance(conditioning, Conditioning):
+        raise TypeError(f"conditioning must be a Conditioning or None, got {type(conditioning).__name__}")
+
+
+def _pchip(forces, fs_in, fs):
+    """Monotone cubic resampling onto ``fs`` (no conditioning): it never overshoots, so F_Z stays >= 0."""
+    t = np.arange(forces.shape[0]) / fs_in
+    grid = np.arange(int(math.floor(t[-1] * fs + 1e-9)) + 1) / fs
+    if t.size < 3:
+        out = np.column_stack([np.interp(grid, t, col) for col in forces.T])
+    else:
+        from scipy.interpolate import PchipInterpolator
+
+        out = np.asarray(PchipInterpolator(t, forces, axis=0)(grid), dtype=float)
+    out[:, 2] = np.maximum(out[:, 2], 0.0)
+    return out

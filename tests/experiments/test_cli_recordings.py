@@ -1,0 +1,57 @@
+"""``ddmm simulate`` on recorded force files: options alone read an AMTI-style plate; bad options are one line."""
+
+import numpy as np
+import pytest
+
+from ddmm.experiments.cli import main
+
+
+def plate(path, sign=-1.0, header="Time,Fx,Fy,Fz", noise=0.01):
+    rng = np.random.default_rng(1)
+    t = np.arange(0, 1.5, 0.001)
+    fz = np.interp(t, [0, 0.3, 0.6, 1.5], [0, 0, 2, 2]) + rng.normal(0, noise, t.size)
+    fy = np.interp(t, [0, 0.8, 1.1, 1.5], [0, 0, 0.5, 0.5]) + rng.normal(0, noise, t.size)
+    rows = "".join(f"{a:.3f},{b:.5f},{c:.5f},{sign * d:.5f}\n" for a, b, c, d in
+                   zip(t, rng.normal(0, noise, t.size), fy, fz))
+    path.write_text(header + "\n" + rows)
+    return path
+
+
+def test_an_amti_plate_with_negative_pressing_via_options_alone(tmp_path, capsys):
+    path = plate(tmp_path / "amti.csv")
+    out = tmp_path / "out.nc"
+    args = ["simulate", "--scene", str(path), "--engine", "direct", "--quiet", "--types", "SAI,RAI"]
+    assert main([*args, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--fz-sign -1" in err and "np.float64" not in err
+    assert main([*args, "--fz-sign", "-1", "--out", str(out)]) == 0 and out.exists()
+
+
+def test_columns_and_units_from_the_command_line(tmp_path, capsys):
+    path = plate(tmp_path / "mn.csv", sign=1.0, header="t_s,FX,FY,FZ")
+    text = path.read_text().splitlines()
+    rows = [",".join([r.split(",")[0]] + [f"{1000 * float(v):.2f}" for v in r.split(",")[1:]]) for r in text[1:]]
+    path.write_text("\n".join([text[0], *rows]) + "\n")
+    out = tmp_path / "out.nc"
+    assert main(["simulate", "--scene", str(path), "--engine", "direct", "--quiet", "--types", "SAI",
+                 "--columns", "time=t_s", "--units", "mN", "--out", str(out)]) == 0
+    import xarray as xr
+
+    with xr.open_dataset(out) as ds:
+        assert ds.sizes["spike"] > 100
+
+
+@pytest.mark.parametrize(("extra", "match"), [
+    (["--columns", "tme=Time"], "--columns: 'tme=Time' is not NAME=COLUMN"),
+    (["--conditioning", "off", "--sensor-noise", "0.01"], "--sensor-noise and --bandwidth set the conditioning"),
+    (["--sensor-noise", "-1"], "noise_n must be a finite number >= 0"),
+    (["--fs", "100"], "has a time column: give recorded_fs \\(--fs\\) only for a file without one"),
+])
+def test_bad_recording_options_are_one_line(tmp_path, capsys, extra, match):
+    path = plate(tmp_path / "p.csv", sign=1.0)
+    code = main(["simulate", "--scene", str(path), "--engine", "direct", "--quiet", "--out",
+                 str(tmp_path / "o.nc"), *extra])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1
+    import re
+    assert re.search(match, err), err

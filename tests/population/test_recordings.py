@@ -1,0 +1,151 @@
+"""Recorded force files and the conditioning stage: readers, errors, chunk invariance, silence on noise,
+sample-rate invariance."""
+
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ddmm.population import Scene, sample_population, simulate
+from ddmm.population.stimuli.conditioning import Conditioner, Conditioning, condition_forces
+from ddmm.population.stimuli.recordings import RecordingBandWarning, from_csv
+
+KNOTS = [0, 0.5, 1.0, 2.0, 2.5, 3.5, 4.0, 5.0]
+PHASES = {"rest": (0.1, 0.5), "press": (0.5, 1.0), "hold": (1.3, 2.0), "push": (2.0, 2.5), "hold2": (2.8, 3.5),
+          "lift": (3.5, 4.0), "after": (4.3, 5.0)}
+
+
+def profile(fs, noise, seed=0):
+    """Press to 3 N, hold, push 1 N distal, hold, lift: (t, forces) with white sensor noise of SD ``noise``."""
+    t = np.arange(0, 5.0, 1 / fs)
+    f = np.column_stack([np.zeros_like(t), np.interp(t, KNOTS, [0, 0, 0, 0, 1, 1, 0, 0]),
+                         np.interp(t, KNOTS, [0, 0, 3, 3, 3, 3, 0, 0])])
+    return t, f + np.random.default_rng(seed).normal(0, noise, f.shape)
+
+
+def write(path, t, f, header="Time,Fx,Fy,Fz", fz_sign=1):
+    rows = "".join(f"{a:.6f},{b:.6f},{c:.6f},{fz_sign * d:.6f}\n" for a, (b, c, d) in zip(t, f))
+    path.write_text(header + "\n" + rows)
+    return path
+
+
+@pytest.fixture(scope="module")
+def pop():
+    return sample_population("fingertip", rng=0).select(np.arange(0, 991, 3))
+
+
+def rates(pop, scene):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = simulate(pop, scene, engine="direct", seed=0, quiet=True)
+    st_, sa, types = ds.spike_time.values, ds.spike_afferent.values, ds.afferent_type.values
+    out = {}
+    for kind in ("SAI", "RAI", "RAII"):
+        sel = types[sa] == kind
+        out[kind] = {p: ((st_[sel] >= a) & (st_[sel] < b)).sum() / (types == kind).sum() / (b - a)
+                     for p, (a, b) in PHASES.items()}
+    return out
+
+
+def test_an_amti_style_file_with_pressing_negative_reads_with_options_alone(tmp_path):
+    t, f = profile(1000.0, 0.0)
+    path = write(tmp_path / "amti.csv", t, f, fz_sign=-1)
+    with pytest.raises(ValueError, match=r"normal force down to -3 N \(line \d+\) and it is never positive: .*"
+                                         r"fz_sign=-1"):
+        from_csv(path)
+    scene = from_csv(path, fz_sign=-1)
+    settled = scene.fz[1500:2000]  # the hold, after the tracker's overshoot at the ramp's end
+    assert np.allclose(settled, 3.0 - Conditioning().contact_on_n, atol=1e-3) and scene.fs == 1000.0
+
+
+def test_units_time_scale_and_a_file_without_time(tmp_path):
+    t, f = profile(1000.0, 0.0)
+    a = from_csv(write(tmp_path / "a.csv", t * 1e3, f * 1e3, "t_ms,FX,FY,FZ"), units="mN", time_scale=1e-3,
+                 columns={"time": "t_ms"})
+    path = tmp_path / "b.csv"
+    path.write_text("Fx,Fy,Fz\n" + "".join(f"{b},{c},{d}\n" for b, c, d in f))
+    b = from_csv(path, recorded_fs=1000.0)
+    np.testing.assert_allclose(a.fz, b.fz, atol=1e-9)
+    with pytest.raises(ValueError, match="units='kN' is not allowed; allowed: N, mN, gf, kgf, lbf"):
+        from_csv(path, recorded_fs=1000.0, units="kN")
+
+
+def test_gaps_are_refused_with_their_time_and_length_or_filled(tmp_path):
+    t, f = profile(100.0, 0.0)
+    keep = (t < 1.0) | (t >= 1.2)
+    path = write(tmp_path / "gap.csv", t[keep], f[keep])
+    with pytest.raises(ValueError, match=r"a gap of 0.21 s at t = 0.99 s \(line 101"):
+        from_csv(path)
+    with pytest.warns(RecordingBandWarning, match="FA-II's band"):
+        scene = from_csv(path, gaps="interpolate")
+    assert scene.duration == pytest.approx(5.0, abs=0.02)
+
+
+def test_an_offset_is_removed_from_the_quiet_baseline(tmp_path):
+    t, f = profile(1000.0, 0.002)
+    path = write(tmp_path / "offset.csv", t, f - [0.1, -0.05, 0.4])
+    with pytest.raises(ValueError, match="negative_fz='offset'"):
+        from_csv(path, conditioning=None)
+    scene = from_csv(path, negative_fz="offset")
+    assert np.all(scene.fz[:400] == 0.0) and np.all(scene.fy[:400] == 0.0)
+
+
+@settings(max_examples=25, deadline=None)
+@given(fs_in=st.sampled_from([100.0, 250.0, 1000.0, 5000.0]), cuts=st.lists(st.integers(0, 120), max_size=6))
+def test_a_stream_of_any_chunking_equals_the_offline_conditioning(fs_in, cuts):
+    _, f = profile(fs_in, 0.02)
+    f = f[: int(0.6 * fs_in)]
+    whole, contact = condition_forces(f, fs_in, 1000.0)
+    c = Conditioner(Conditioning(), fs_in, 1000.0)
+    edges = sorted({0, f.shape[0], *[min(x, f.shape[0]) for x in cuts]})
+    parts = [c.push(f[a:b]) for a, b in zip(edges[:-1], edges[1:])]
+    np.testing.assert_array_equal(np.concatenate([p[0] for p in parts]), whole)
+    np.testing.assert_array_equal(np.concatenate([p[1] for p in parts]), contact)
+
+
+@pytest.mark.parametrize("fs_in", [100.0, 1000.0])
+def test_noise_on_a_free_sensor_is_not_contact_and_zero_shear_does_not_spin(fs_in):
+    _, f = profile(fs_in, 0.02)
+    out, contact = condition_forces(f, fs_in, 1000.0)
+    rest, hold = slice(0, 450), slice(1300, 2000)
+    assert not contact[rest].any() and np.all(out[rest] == 0.0)
+    assert contact[hold].all() and np.all(out[hold, :2] == 0.0) and np.all(out[:, 2] >= 0.0)
+
+
+@pytest.mark.parametrize(("kwargs", "match"), [
+    ({"noise_n": -0.01}, "noise_n must be a finite number >= 0"),
+    ({"contact_on_n": 0.01}, "contact_on_n must be a finite number > contact_off_n = 0.015"),
+    ({"bandwidth_hz": 0.0}, "bandwidth_hz must be a finite number > 0"),
+    ({"mode": "acausal"}, "mode='acausal' is not allowed; allowed: causal, zero_phase"),
+])
+def test_bad_conditioning_is_named(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        Conditioning(**kwargs)
+
+
+@pytest.mark.parametrize("fs_in", [100.0, 1000.0])
+def test_fast_afferents_are_silent_at_rest_and_in_holds_with_20_mN_of_noise(pop, fs_in):
+    _, f = profile(fs_in, 0.02, seed=int(fs_in))
+    out, _ = condition_forces(f, fs_in, 1000.0)
+    r = rates(pop, Scene(*out.T, fs=1000.0, name="plate"))
+    for kind in ("RAI", "RAII"):
+        for phase in ("rest", "hold", "after"):
+            assert r[kind][phase] == 0.0, (kind, phase, r[kind][phase])
+        # the sheared hold: the shear term multiplies the slow band's noise; measured 1.6 pulses/s for FA-I at
+        # 100 Hz and 20 mN (docs/recordings.md, a shortfall), 0.1 at 1 kHz
+        assert r[kind]["hold2"] <= 2.0, (kind, r[kind]["hold2"])
+
+
+def test_100_hz_and_1_khz_recordings_give_the_same_rates_within_20_percent(pop):
+    """SA-I and FA-I, every phase with at least 2 imp/s, 5 mN of noise (docs/recordings.md has 10 and 20 mN)."""
+    got = {}
+    for fs_in in (100.0, 1000.0):
+        _, f = profile(fs_in, 0.005, seed=int(fs_in))
+        got[fs_in] = rates(pop, Scene(*condition_forces(f, fs_in, 1000.0)[0].T, fs=1000.0, name="plate"))
+    for kind in ("SAI", "RAI"):
+        for phase in PHASES:
+            a, b = got[100.0][kind][phase], got[1000.0][kind][phase]
+            if max(a, b) >= 2.0:
+                assert max(a, b) / min(a, b) <= 1.2, (kind, phase, a, b)
