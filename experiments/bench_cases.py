@@ -31,9 +31,9 @@ CASES = {
     "hand_10s_direct": ("hand", "direct", 10.0, False),
 }
 #: Cases beyond one process: 100,000 afferents in-process and on 2 local Dask
-#: workers, and the streaming encoder's per-chunk latency.
+#: workers, and the streaming encoder's per-chunk latency (raw forces, and through the conditioning stage).
 EXTRA_CASES = ("scale_100k_inprocess", "scale_100k_2workers", "stream_fingertip", "stream_hand",
-               "hand_5sites_1s_direct", "fingertip_16taxels_1s_direct")
+               "stream_fingertip_conditioned", "hand_5sites_1s_direct", "fingertip_16taxels_1s_direct")
 #: ``--cases scaling``: afferents x simulated seconds, each in a fresh process.
 SCALING = tuple(f"scaling_{n}k_{t}s" for n in (1, 10, 100) for t in (1, 10))
 #: Multi-site cases and the one-site case each is compared with (same population, same run).
@@ -144,8 +144,11 @@ def _scale_case(workers: int) -> dict:
     return result
 
 
-def _stream_case(population: str, seconds: float = 3.0) -> dict:
+def _stream_case(population: str, seconds: float = 3.0, conditioned: bool = False) -> dict:
     """Per-chunk processing time of the streaming encoder, 1 ms chunks at fs = 1 kHz, paced in real time.
+
+    ``conditioned``: the encoder's default conditioning stage on (a live
+    sensor); otherwise the forces are taken as they are (noise-free forces).
 
     Chunks arrive every millisecond, as from a sensor; each push's processing
     time is measured.  (A loop pushing as fast as it can would measure
@@ -159,7 +162,7 @@ def _stream_case(population: str, seconds: float = 3.0) -> dict:
     pop = sample_population(population, rng=0)
     scene = birznieks(90.0, hold_s=seconds - 0.25)
     forces = np.column_stack([scene.fx, scene.fy, scene.fz])
-    enc = Encoder(pop, 1000.0, dt=DT, engine="direct", seed=0)
+    enc = Encoder(pop, 1000.0, dt=DT, engine="direct", seed=0, **({} if conditioned else {"conditioning": None}))
     enc.push(forces[:200])  # warm-up (numba kernels)
     enc.reset()
     enc.wait_ready()
@@ -181,7 +184,7 @@ def _stream_case(population: str, seconds: float = 3.0) -> dict:
         start = time.perf_counter()
         enc.push(forces[k:k + 1])
         laps[k] = time.perf_counter() - start
-    return {"name": f"stream_{population}", "engine": "direct", "n_afferents": len(pop), "sim_s": seconds,
+    return {"name": f"stream_{population}" + ("_conditioned" if conditioned else ""), "engine": "direct", "n_afferents": len(pop), "sim_s": seconds,
             "dt_ms": DT * 1e3, "wall_s": round(float(laps.sum()), 3),
             "afferent_s_per_wall_s": round(len(pop) * seconds / float(laps.sum()), 1),
             "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
@@ -261,7 +264,8 @@ def run_extra(name: str) -> dict:
         return _sites_case(name)
     if name.startswith("scale_100k"):
         return _scale_case(0 if name.endswith("inprocess") else int(name.split("_")[-1][0]))
-    return _stream_case(name.split("_", 1)[1])
+    population = name.split("_")[1]
+    return _stream_case(population, conditioned=name.endswith("_conditioned"))
 
 
 def _cold_main(engine: str, out: str) -> None:

@@ -6,7 +6,8 @@ import time
 import warnings
 from pathlib import Path
 
-from ddmm.experiments.cmd_recordings import add_recording_options, csv_scene
+from ddmm.experiments.cmd_recordings import (add_recording_options, conditioning_from_args, csv_scene,
+                                            refuse_csv_options)
 from ddmm.experiments.io import ensure_out_dir, save_figure
 from ddmm.population.io.arrays import EXTENSIONS
 
@@ -101,7 +102,11 @@ def _array_scene(args):
         raise ValueError("--contact does not apply to a sensor-array scene: each site has its own footprint")
     if args.theta_r is not None:
         raise ValueError("--theta-r does not apply to a sensor-array scene: the file gives the forces")
-    return from_array(args.scene) if suffix in EXTENSIONS else from_long_csv(args.scene, args.sites)
+    refuse_csv_options(args, args.scene)
+    conditioning = conditioning_from_args(args)
+    if suffix in EXTENSIONS:
+        return from_array(args.scene, conditioning=conditioning)
+    return from_long_csv(args.scene, args.sites, conditioning=conditioning)
 
 
 def scenes_from_args(args) -> list:
@@ -122,6 +127,9 @@ def scenes_from_args(args) -> list:
         start = _directions(args.theta_r, default="0")
         return [rotating_shear(start_deg=start[0] or 0.0, contact=contact)]
     if args.scene.lower().endswith(".csv"):
+        if args.theta_r is not None:
+            raise ValueError(f"--theta-r does not apply to the recorded scene {args.scene!r}: the file gives the "
+                             "forces")
         return [csv_scene(args.scene, args, contact)]
     raise ValueError(f"--scene {args.scene!r} is unknown; allowed: {', '.join(SCENES)}, a .csv file or a "
                      f"sensor-array file ({', '.join(EXTENSIONS)})")

@@ -3,9 +3,12 @@
 
 from __future__ import annotations
 
-__all__ = ["add_recording_options", "conditioning_from_args", "csv_scene"]
+__all__ = ["add_recording_options", "conditioning_from_args", "csv_scene", "refuse_csv_options"]
 
 _FIELDS = ("time", "fx", "fy", "fz")
+# the single-site CSV reader's options and their defaults (a sensor-array file states its own)
+_CSV_ONLY = {"columns": None, "fs": None, "time_scale": 1.0, "negative_fz": "error", "gaps": "error",
+             "units": "N", "fz_sign": 1}
 
 
 def add_recording_options(p, *, stream: bool = False) -> None:
@@ -50,6 +53,14 @@ def conditioning_from_args(args):
     if args.bandwidth is not None:
         settings["bandwidth_hz"] = args.bandwidth
     return Conditioning(**settings)
+
+
+def refuse_csv_options(args, scene: str) -> None:
+    """Raise if a single-site CSV option was given for ``scene`` (a sensor-array file), which has none."""
+    for name, default in _CSV_ONLY.items():
+        if getattr(args, name, default) != default:
+            raise ValueError(f"--{name.replace('_', '-')} applies to a single-site .csv --scene, not to the "
+                             f"sensor-array scene {scene!r} (its file states forces in N, F_Z >= 0)")
 
 
 def _columns(text):

@@ -72,8 +72,9 @@ def read_sites_csv(path):
     return where, fields, lines
 
 
-def read_long_forces(path, known: dict):
-    """Rows of ``time,site,fx,fy,fz``: times (s), site indices, forces (N) and line numbers."""
+def read_long_forces(path, known: dict, allowance: float = 0.0):
+    """Rows of ``time,site,fx,fy,fz``: times (s), site indices, forces (N) and line numbers; F_Z may read
+    down to ``-allowance`` N (sensor noise the conditioning handles)."""
     where, index, rows = _csv_rows(path, "forces", ("time", "site", "fx", "fy", "fz"))
     n = len(rows)
     t, site, force, lines = np.empty(n), np.empty(n, dtype=int), np.empty((n, 3)), np.empty(n, dtype=int)
@@ -85,8 +86,9 @@ def read_long_forces(path, known: dict):
         t[r] = _cell_float(where, "time", line, row[index["time"]])
         for a, col in enumerate(("fx", "fy", "fz")):
             force[r, a] = _cell_float(where, col, line, row[index[col]])
-        if force[r, 2] < 0:
-            raise ValueError(f"{where}: column 'fz', line {line}: negative normal force {float(force[r, 2])!r} N")
+        if force[r, 2] < -allowance:
+            raise ValueError(f"{where}: column 'fz', line {line}: negative normal force {float(force[r, 2]):g} N"
+                             + (f" (below the sensor-noise allowance of -{allowance:g} N)" if allowance else ""))
     return where, t, site, force, lines
 
 

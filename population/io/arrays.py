@@ -70,7 +70,9 @@ import numpy as np
 
 from ddmm.population.io._files import atomic_write
 from ddmm.population.io._long_csv import TIME_TOL, read_long_forces, read_sites_csv, uniform_grid
-from ddmm.population.stimuli.scenes import Scene, Sites, taxel_radius
+from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
+from ddmm.population.stimuli.recordings import RECORDED, warn_band
+from ddmm.population.stimuli.scenes import DEFAULT_FS, Scene, Sites, taxel_radius
 
 __all__ = ["EXTENSIONS", "from_array", "save_array", "from_long_csv", "default_radius"]
 
@@ -153,8 +155,9 @@ def _check_fs(where: str, value) -> float:
     return float(fs)
 
 
-def _scene_from_fields(where: str, fields: dict, name: str) -> Scene:
-    """Validate raw ``fields`` (the layout's names) and build the scene; errors name ``where``."""
+def _scene_from_fields(where: str, fields: dict, name: str, conditioning=None, source: str | None = None) -> Scene:
+    """Validate raw ``fields`` (the layout's names) and build the scene, conditioned when ``conditioning`` is
+    given (to the model's rate: the file's, at least 1 kHz); errors name ``where``, a band warning ``source``."""
     missing = [k for k in _REQUIRED if k not in fields]
     if missing:
         raise ValueError(f"{where}: missing field {missing[0]!r}; required: {', '.join(_REQUIRED)}")
@@ -163,14 +166,22 @@ def _scene_from_fields(where: str, fields: dict, name: str) -> Scene:
     n_samples, n_sites = forces.shape[:2]
     if n_samples == 0 or n_sites == 0:
         raise ValueError(f"{where}: field 'forces' needs at least one sample and one site, got shape {forces.shape}")
-    negative = forces[:, :, 2] < 0
+    allowance = 0.0 if conditioning is None else noise_allowance(conditioning)
+    negative = forces[:, :, 2] < -allowance
     if negative.any():
         k, j = (int(i) for i in np.argwhere(negative)[0])
-        raise ValueError(f"{where}: field 'forces' has a negative normal force {float(forces[k, j, 2])!r} N at index "
-                         f"[{k}, {j}, 2] (F_Z must be >= 0)")
+        raise ValueError(f"{where}: field 'forces' has a negative normal force {float(forces[k, j, 2]):g} N at index "
+                         f"[{k}, {j}, 2] " + (f"(below the sensor-noise allowance of -{allowance:g} N)" if allowance
+                                                  else "(F_Z must be >= 0)"))
     x = _numeric(where, "x_mm", fields["x_mm"], (n_sites,))
     y = _numeric(where, "y_mm", fields["y_mm"], (n_sites,))
-    return Scene.from_sites(forces, _sites(where, fields, x, y), fs=fs, name=name)
+    sites = _sites(where, fields, x, y)
+    warn_band(source or where, fs)
+    if conditioning is not None:
+        fs_out = max(fs, DEFAULT_FS)
+        forces, _ = condition_forces(forces, fs, fs_out, conditioning)
+        fs = fs_out
+    return Scene.from_sites(forces, sites, fs=fs, name=name)
 
 
 def _sites(where: str, fields: dict, x: np.ndarray, y: np.ndarray) -> Sites:
@@ -265,7 +276,7 @@ def _read_hdf5(path, where: str) -> dict:
 _READERS = {"npz": _read_npz, "netcdf": _read_netcdf, "hdf5": _read_hdf5}
 
 
-def from_array(path, *, name: str | None = None) -> Scene:
+def from_array(path, *, name: str | None = None, conditioning: Conditioning | None = RECORDED) -> Scene:
     """A multi-site scene from a sensor-array file (``.npz``, ``.nc``, ``.h5`` / ``.hdf5``).
 
     The layouts are in this module's docstring: forces (n_samples, n_sites, 3)
@@ -278,6 +289,11 @@ def from_array(path, *, name: str | None = None) -> Scene:
         The file; its extension picks the format.
     name : str, optional
         Condition name (default: the file stem).
+    conditioning : Conditioning or None
+        The conditioning stage for recorded forces (default on, as
+        `ddmm.population.stimuli.recordings.from_csv`; docs/recordings.md): the scene is at the file's
+        rate, or 1 kHz if the file is slower.  None: the forces as stored
+        (F_Z >= 0 required), e.g. a scene `save_array` wrote.
 
     Returns
     -------
@@ -298,7 +314,7 @@ def from_array(path, *, name: str | None = None) -> Scene:
     ...     path = pathlib.Path(tmp) / "pad.npz"
     ...     np.savez(path, fs=500.0, forces=np.ones((50, 4, 3)), x_mm=[0.0, 2.0, 0.0, 2.0],
     ...              y_mm=[0.0, 0.0, 2.0, 2.0])
-    ...     scene = from_array(path)
+    ...     scene = from_array(path, conditioning=None)
     >>> scene.n_sites, round(float(scene.sites.radius_mm[0]), 4)
     (4, 1.1284)
     """
@@ -306,7 +322,7 @@ def from_array(path, *, name: str | None = None) -> Scene:
     where = f"array file {str(path)!r}"
     if not Path(path).is_file():
         raise ValueError(f"{where} does not exist")
-    return _scene_from_fields(where, _READERS[kind](path, where), name or Path(path).stem)
+    return _scene_from_fields(where, _READERS[kind](path, where), name or Path(path).stem, conditioning)
 
 
 # --- writing -------------------------------------------------------------------------------------
@@ -402,7 +418,8 @@ def save_array(path, scene: Scene) -> Path:
 # --- long CSV ------------------------------------------------------------------------------------
 
 
-def from_long_csv(forces_csv, sites_csv, *, fs: float | None = None, name: str | None = None) -> Scene:
+def from_long_csv(forces_csv, sites_csv, *, fs: float | None = None, name: str | None = None,
+                  conditioning: Conditioning | None = RECORDED) -> Scene:
     """A multi-site scene from a long CSV of forces and a CSV table of sites.
 
     ``forces_csv`` has the header ``time,site,fx,fy,fz`` (any column order;
@@ -425,6 +442,8 @@ def from_long_csv(forces_csv, sites_csv, *, fs: float | None = None, name: str |
         checked against it (needed when there is a single time stamp).
     name : str, optional
         Condition name (default: the stem of ``forces_csv``).
+    conditioning : Conditioning or None
+        As `from_array` (default on; None: the forces as written).
 
     Raises
     ------
@@ -442,7 +461,7 @@ def from_long_csv(forces_csv, sites_csv, *, fs: float | None = None, name: str |
     ...     sites = pathlib.Path(tmp) / "sites.csv"
     ...     _ = forces.write_text("time,site,fx,fy,fz\\n0,a,0,0,1\\n0,b,0,0,2\\n0.01,a,0,0.1,1\\n0.01,b,0,0,2\\n")
     ...     _ = sites.write_text("site,x_mm,y_mm,radius_mm\\na,0,0,1.5\\nb,3,0,1.5\\n")
-    ...     scene = from_long_csv(forces, sites)
+    ...     scene = from_long_csv(forces, sites, conditioning=None)
     >>> scene.n_sites, scene.n_samples, round(scene.fs, 6), list(scene.sites.site_id)
     (2, 2, 100.0, ['a', 'b'])
     """
@@ -452,7 +471,8 @@ def from_long_csv(forces_csv, sites_csv, *, fs: float | None = None, name: str |
         fs = check_positive(fs, "fs", "Hz")
     sites_where, table, site_lines = read_sites_csv(sites_csv)
     known = {s: i for i, s in enumerate(table["site"])}
-    where, t, site, force, lines = read_long_forces(forces_csv, known)
+    allowance = 0.0 if conditioning is None else noise_allowance(conditioning)
+    where, t, site, force, lines = read_long_forces(forces_csv, known, allowance)
     times, slot = np.unique(t, return_inverse=True)
     fs = uniform_grid(where, times, fs, t, lines)
     filled = np.full((times.size, len(known)), -1, dtype=int)
@@ -470,4 +490,4 @@ def from_long_csv(forces_csv, sites_csv, *, fs: float | None = None, name: str |
     fields = {"fs": fs, "forces": force[filled], "x_mm": table["x_mm"], "y_mm": table["y_mm"],
               "radius_mm": table["radius_mm"], "region": table["region"], "site": table["site"]}
     # the forces are checked row by row above; what is left to fail is the sites' footprint
-    return _scene_from_fields(sites_where, fields, name or Path(forces_csv).stem)
+    return _scene_from_fields(sites_where, fields, name or Path(forces_csv).stem, conditioning, where)

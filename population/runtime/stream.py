@@ -28,6 +28,7 @@ from ddmm.population.runtime.noise import noise_key, root_seed
 from ddmm.population.sampling import Population
 from ddmm.population.simulation import _grouped, block_pipeline
 from ddmm.population.stimuli.conditioning import Conditioner, Conditioning, noise_allowance
+from ddmm.population.stimuli.recordings import RECORDED
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Contact, Sites
 
 __all__ = ["StreamSpikes", "Encoder"]
@@ -77,14 +78,15 @@ class Encoder:
     types : sequence of str, optional
         Afferent types to simulate (as `simulate`'s ``types``); the others
         never spike.  A sensor too slow for FA-II leaves them out this way.
-    conditioning : Conditioning, optional
-        For a live sensor: pushed samples (at ``fs``) pass through the causal
-        conditioning stage (`ddmm.population.stimuli.conditioning`), which
-        brings them to ``model_fs``; the spikes then equal an offline
-        `from_csv` of the same samples with the same conditioning, bit for
-        bit.  None (default): forces are taken as they are, as `simulate`
-        takes a `Scene` (the stage costs ~0.17 ms a push, more than a
-        fingertip push's integration; ``ddmm stream`` switches it on).
+    conditioning : Conditioning or None
+        The causal conditioning stage for a live sensor
+        (`ddmm.population.stimuli.conditioning`; default on, `RECORDED`, as
+        for recorded files): pushed samples (at ``fs``) are conditioned and
+        brought to ``model_fs``, and the spikes equal an offline `from_csv`
+        of the same samples with the same conditioning, bit for bit.  None:
+        forces are taken as they are, as `simulate` takes a `Scene` (for
+        noise-free forces, e.g. a simulated robot; it also saves the stage's
+        ~0.17 ms a push).
     model_fs : float, optional
         The model's sample rate with ``conditioning`` (default 1000 Hz, the
         rate `from_csv` gives); without it the model runs at ``fs``.
@@ -98,7 +100,7 @@ class Encoder:
     Examples
     --------
     >>> from ddmm.population import make_population
-    >>> enc = Encoder(make_population(["SAI"]), fs=1000.0, engine="direct", seed=1)
+    >>> enc = Encoder(make_population(["SAI"]), fs=1000.0, engine="direct", seed=1)  # conditioned
     >>> out = enc.push(np.column_stack([np.zeros(300), np.zeros(300), np.full(300, 4.0)]))
     >>> bool(out.afferent.size > 0)
     True
@@ -106,7 +108,7 @@ class Encoder:
 
     def __init__(self, population, fs: float, *, dt: float = 1e-4, engine: str = "direct", method: str = "euler",
                  seed=None, no_shear: str = "smooth", contact: Contact | None = None, sites: Sites | None = None,
-                 types=None, conditioning: Conditioning | None = None, model_fs: float | None = None):
+                 types=None, conditioning: Conditioning | None = RECORDED, model_fs: float | None = None):
         if not isinstance(population, Population):
             raise TypeError(f"population must be a Population, got {type(population).__name__}")
         self.fs = check_positive(fs, "fs", "Hz")

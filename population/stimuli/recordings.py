@@ -23,7 +23,8 @@ from ddmm.models._validation import check_positive
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Contact, Scene
 
-__all__ = ["from_csv", "UNITS", "RECORDED", "RecordingBandWarning", "NEGATIVE_FZ", "GAPS", "FA_II_MIN_FS"]
+__all__ = ["from_csv", "warn_band", "UNITS", "RECORDED", "RecordingBandWarning", "NEGATIVE_FZ", "GAPS",
+           "FA_II_MIN_FS"]
 
 #: Force units a file may be in, and their value in newtons.
 UNITS = {"N": 1.0, "mN": 1e-3, "gf": 9.80665e-3, "kgf": 9.80665, "lbf": 4.4482216152605}
@@ -206,16 +207,20 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
     scale = UNITS[units] * check_positive(force_scale, "force_scale")
     forces = np.column_stack([data["fx"] * scale, data["fy"] * scale, data["fz"] * scale * fz_sign])
     forces = _negative(path, forces[:, 2], forces, negative_fz, conditioning, fs_in)
-    if fs_in < FA_II_MIN_FS:
-        warnings.warn(RecordingBandWarning(
-            f"{Path(path).name} is sampled at {fs_in:g} Hz and carries 0-{fs_in / 2:g} Hz: FA-II's band "
-            f"(120-300 Hz) is missing, so FA-II respond only to its ramps (leave them out with types=...)"),
-            stacklevel=2)
+    warn_band(Path(path).name, fs_in, stacklevel=3)
     if conditioning is None:
         out = _pchip(forces, fs_in, fs)
     else:
         out, _ = condition_forces(forces, fs_in, fs, conditioning)
     return Scene(out[:, 0], out[:, 1], out[:, 2], fs=fs, name=name or Path(path).stem, contact=contact)
+
+
+def warn_band(what: str, fs_in: float, stacklevel: int = 4) -> None:
+    """Warn (`RecordingBandWarning`) when a recording at ``fs_in`` Hz cannot carry FA-II's band."""
+    if fs_in < FA_II_MIN_FS:
+        warnings.warn(RecordingBandWarning(
+            f"{what} is sampled at {fs_in:g} Hz and carries 0-{fs_in / 2:g} Hz: FA-II's band (120-300 Hz) is "
+            "missing, so FA-II respond only to its ramps (leave them out with types=...)"), stacklevel=stacklevel)
 
 
 def _check_options(fs, units, fz_sign, negative_fz, gaps, conditioning) -> None:

@@ -5,7 +5,8 @@ import pytest
 
 from ddmm.experiments.cli import main
 from ddmm.population import load_dataset
-from ddmm.population.io.arrays import save_array
+from ddmm.population.io.arrays import from_array, save_array
+from ddmm.population.stimuli.recordings import RecordingBandWarning
 from ddmm.population.stimuli.scenes import Scene, Sites
 
 
@@ -32,8 +33,25 @@ def test_plan_reads_each_array_format(capsys, tmp_path, ext):
 def test_plan_reads_long_csv_with_sites(capsys, tmp_path):
     (tmp_path / "f.csv").write_text("time,site,fx,fy,fz\n0,a,0,0,1\n0,b,0,0,1\n0.01,a,0,0,1\n0.01,b,0,0,1\n")
     (tmp_path / "s.csv").write_text("site,x_mm,y_mm\na,0,0\nb,2,0\n")
-    code, text, err = run(capsys, "plan", "--scene", tmp_path / "f.csv", "--sites", tmp_path / "s.csv")
+    args = ("plan", "--scene", tmp_path / "f.csv", "--sites", tmp_path / "s.csv")
+    with pytest.warns(RecordingBandWarning, match="f.csv' is sampled at 100 Hz"):
+        code, text, err = run(capsys, *args)
+    # conditioned (the default for recorded forces) to the model's 1 kHz; as written when switched off
+    assert code == 0 and "condition 'f': 0.02 s at 1000 Hz" in text, err
+    with pytest.warns(RecordingBandWarning):
+        code, text, err = run(capsys, *args, "--conditioning", "off")
     assert code == 0 and "condition 'f': 0.02 s at 100 Hz" in text, err
+
+
+def test_array_scene_is_conditioned_by_default(capsys, tmp_path):
+    """Sensor noise on an unloaded taxel is neither contact nor shear once conditioned."""
+    scene = pad_scene()
+    noisy = scene.site_forces + np.random.default_rng(0).normal(0.0, 0.01, scene.site_forces.shape)
+    noisy[..., 2] = np.abs(noisy[..., 2])
+    path = save_array(tmp_path / "noisy.npz", Scene.from_sites(noisy, scene.sites, fs=1000.0))
+    quiet = from_array(path).site_forces
+    assert np.all(quiet[:, 1:] == 0.0)  # the three unloaded taxels read no force at all
+    assert np.array_equal(from_array(path, conditioning=None).site_forces, noisy)
 
 
 def test_csv_without_sites_keeps_the_single_site_reader(capsys, tmp_path):
@@ -79,7 +97,8 @@ def long_files(tmp_path, forces="time,site,fx,fy,fz\n0,a,0,0,1\n0,c,0,0,1\n"):
 
 
 @pytest.mark.parametrize("make_args,match", [
-    (lambda p: ["--scene", bad_npz(p)], r"bad.npz': field 'forces' has a negative normal force -1.0 N at index [3, 1, 2]"),
+    (lambda p: ["--scene", bad_npz(p)], "bad.npz': field 'forces' has a negative normal force -1 N at index [3, 1, 2] (below the sensor-noise "
+     "allowance of -0.13 N)"),
     (lambda p: ["--scene", p / "missing.h5"], "missing.h5' does not exist"),
     (lambda p: ["--scene", long_files(p)[0], "--sites", long_files(p)[1]],
      "f.csv': column 'site', line 3: site 'c' is not in the sites table"),
@@ -90,6 +109,12 @@ def long_files(tmp_path, forces="time,site,fx,fy,fz\n0,a,0,0,1\n0,c,0,0,1\n"):
      "--contact does not apply to a sensor-array scene"),
     (lambda p: ["--scene", save_array(p / "a.h5", pad_scene()), "--theta-r", "90"],
      "--theta-r does not apply to a sensor-array scene"),
+    (lambda p: ["--scene", save_array(p / "a.h5", pad_scene()), "--units", "mN"],
+     "--units applies to a single-site .csv --scene, not to the sensor-array scene"),
+    (lambda p: ["--scene", save_array(p / "a.npz", pad_scene()), "--fz-sign", "-1"],
+     "--fz-sign applies to a single-site .csv --scene"),
+    (lambda p: ["--scene", save_array(p / "a.npz", pad_scene()), "--conditioning", "off", "--sensor-noise", "0.01"],
+     "--sensor-noise and --bandwidth set the conditioning, which --conditioning off switches off"),
     (lambda p: ["--scene", p / "a.mat"], "sensor-array file (.npz, .nc, .h5, .hdf5)"),
 ])
 def test_bad_array_scene_exit_2_nothing_written(capsys, tmp_path, make_args, match):

@@ -46,6 +46,7 @@ def test_columns_and_units_from_the_command_line(tmp_path, capsys):
     (["--conditioning", "off", "--sensor-noise", "0.01"], "--sensor-noise and --bandwidth set the conditioning"),
     (["--sensor-noise", "-1"], "noise_n must be a finite number >= 0"),
     (["--fs", "100"], "has a time column: give recorded_fs \\(--fs\\) only for a file without one"),
+    (["--theta-r", "90"], "--theta-r does not apply to the recorded scene '.*p.csv': the file gives the forces"),
 ])
 def test_bad_recording_options_are_one_line(tmp_path, capsys, extra, match):
     path = plate(tmp_path / "p.csv", sign=1.0)

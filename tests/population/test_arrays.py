@@ -44,9 +44,9 @@ def npz(tmp_path, name="a.npz", **fields):
 @pytest.mark.parametrize("ext", EXTS)
 def test_round_trip_each_format(tmp_path, ext):
     scene = make_scene()
-    back = from_array(save_array(tmp_path / f"taxels{ext}", scene))
+    back = from_array(save_array(tmp_path / f"taxels{ext}", scene), conditioning=None)
     assert_same(scene, back)
-    assert back.name == "taxels" and from_array(tmp_path / f"taxels{ext}", name="x").name == "x"
+    assert back.name == "taxels" and from_array(tmp_path / f"taxels{ext}", name="x", conditioning=None).name == "x"
     np.testing.assert_allclose(back.fz, scene.site_forces[:, :, 2].sum(axis=1))
 
 
@@ -55,12 +55,12 @@ def test_round_trip_each_format(tmp_path, ext):
        fs=st.floats(1.0, 1e5), ext=st.sampled_from(EXTS))
 def test_round_trip_property(tmp_path_factory, n_samples, n_sites, seed, fs, ext):
     scene = make_scene(n_samples, n_sites, seed, fs)
-    assert_same(scene, from_array(save_array(tmp_path_factory.mktemp("rt") / f"s{ext}", scene)))
+    assert_same(scene, from_array(save_array(tmp_path_factory.mktemp("rt") / f"s{ext}", scene), conditioning=None))
 
 
 def test_one_site_scene_with_contact_is_saved_as_one_site(tmp_path):
     scene = birznieks(90.0, contact=Contact(1.0, 2.0, 3.0))
-    back = from_array(save_array(tmp_path / "one.npz", scene))
+    back = from_array(save_array(tmp_path / "one.npz", scene), conditioning=None)
     assert back.n_sites == 1 and back.sites.radius_mm[0] == 3.0
     np.testing.assert_array_equal(back.fy, scene.fy)
 
@@ -79,17 +79,17 @@ def test_foreign_netcdf_and_hdf5_layouts(tmp_path):
     xr.Dataset({"forces": (("time", "site", "axis"), forces), "x_mm": ("site", [0.0, 1.0]),
                 "y_mm": ("site", [0.0, 0.0]), "fs": 200.0, "radius_mm": 0.7},
                coords={"site": [7, 9]}).to_netcdf(tmp_path / "a.nc", engine="h5netcdf")
-    s = from_array(tmp_path / "a.nc")
+    s = from_array(tmp_path / "a.nc", conditioning=None)
     assert s.fs == 200.0 and list(s.sites.site_id) == ["7", "9"] and list(s.sites.radius_mm) == [0.7, 0.7]
     with h5py.File(tmp_path / "b.h5", "w") as fh:
         fh["forces"], fh["x_mm"], fh["y_mm"], fh["fs"] = forces, [0.0, 2.5], [0.0, 0.0], 50.0
-    s = from_array(tmp_path / "b.h5")
+    s = from_array(tmp_path / "b.h5", conditioning=None)
     assert s.fs == 50.0 and s.sites.radius_mm[0] == pytest.approx(taxel_radius(2.5))
     assert list(s.sites.region) == ["", ""] and list(s.sites.site_id) == ["0", "1"]
     with h5py.File(tmp_path / "b.h5", "a") as fh:
         del fh["fs"]
         fh.attrs["fs"] = np.array([75.0])  # a one-element attribute, as netCDF-C tools write scalars
-    assert from_array(tmp_path / "b.h5").fs == 75.0
+    assert from_array(tmp_path / "b.h5", conditioning=None).fs == 75.0
 
 
 def test_default_radius_is_equal_area_of_median_pitch(tmp_path):
@@ -97,7 +97,7 @@ def test_default_radius_is_equal_area_of_median_pitch(tmp_path):
     y = [0.0, 0.0, 0.0, 2.0, 2.0, 2.0, 0.0]
     assert default_radius(x, y) == pytest.approx(2.0 / np.sqrt(np.pi))
     path = npz(tmp_path, forces=np.ones((3, 7, 3)), x_mm=x, y_mm=y)
-    assert from_array(path).sites.radius_mm == pytest.approx(np.full(7, 2.0 / np.sqrt(np.pi)))
+    assert from_array(path, conditioning=None).sites.radius_mm == pytest.approx(np.full(7, 2.0 / np.sqrt(np.pi)))
 
 
 # --- atomicity ---------------------------------------------------------------------------------
@@ -122,7 +122,7 @@ def test_failing_write_keeps_the_old_file(tmp_path, monkeypatch):
     monkeypatch.setitem(arrays._WRITERS, "npz", lambda tmp, fields: (_ for _ in ()).throw(OSError("boom")))
     with pytest.raises(OSError):
         save_array(path, make_scene(seed=2))
-    assert_same(make_scene(seed=1), from_array(path))
+    assert_same(make_scene(seed=1), from_array(path, conditioning=None))
     assert [p.name for p in tmp_path.iterdir()] == ["s.npz"]
 
 
@@ -177,7 +177,7 @@ def test_array_errors_in_netcdf_and_hdf5(tmp_path, ext):
             from_array(tmp_path / "bad.nc")
         ds = ds.drop_vars("extra")
         ds.to_netcdf(tmp_path / "neg.nc", engine="h5netcdf")
-        with pytest.raises(ValueError, match=r"'.*neg.nc'.*negative normal force -1.0 N at index \[3, 1, 2\]"):
+        with pytest.raises(ValueError, match=r"'.*neg.nc'.*negative normal force -1 N at index \[3, 1, 2\] \(below the sensor-noise allowance of -0.13 N\)"):
             from_array(tmp_path / "neg.nc")
         ds = ds.assign_coords(time=ds.time.values * 1.01)
         ds.to_netcdf(tmp_path / "time.nc", engine="h5netcdf")
@@ -233,12 +233,12 @@ def long_csv(tmp_path, forces=FORCES, sites=SITES):
 
 
 def test_long_csv(tmp_path):
-    scene = from_long_csv(*long_csv(tmp_path))
+    scene = from_long_csv(*long_csv(tmp_path), conditioning=None)
     assert scene.fs == pytest.approx(100.0) and scene.name == "f" and list(scene.sites.site_id) == ["a", "b"]
     np.testing.assert_array_equal(scene.site_forces[1], [[0, 0.1, 1], [0, 0.25, 2]])
     np.testing.assert_array_equal(scene.site_forces[0, 1], [0.5, 0, 2])
     assert list(scene.sites.region) == ["D2d", "D2d"] and list(scene.sites.radius_mm) == [1.5, 1.5]
-    assert from_long_csv(*long_csv(tmp_path), fs=100.0, name="n").name == "n"
+    assert from_long_csv(*long_csv(tmp_path), fs=100.0, name="n", conditioning=None).name == "n"
 
 
 def test_long_csv_matches_array_round_trip(tmp_path):
@@ -250,18 +250,18 @@ def test_long_csv_matches_array_round_trip(tmp_path):
     table = ["site,x_mm,y_mm,region,radius_mm"] + [
         ",".join([i, repr(x), repr(y), g, repr(r)])
         for i, x, y, g, r in zip(s.site_id, s.x_mm.tolist(), s.y_mm.tolist(), s.region, s.radius_mm.tolist())]
-    back = from_long_csv(*long_csv(tmp_path, "\n".join(rows), "\n".join(table)), fs=250.0)
+    back = from_long_csv(*long_csv(tmp_path, "\n".join(rows), "\n".join(table)), fs=250.0, conditioning=None)
     assert_same(scene, back)
 
 
 def test_long_csv_default_radius_and_single_time(tmp_path):
     sites = "site,x_mm,y_mm\na,0,0\nb,2.5,0\n"
-    scene = from_long_csv(*long_csv(tmp_path, sites=sites))
+    scene = from_long_csv(*long_csv(tmp_path, sites=sites), conditioning=None)
     assert scene.sites.radius_mm[0] == pytest.approx(taxel_radius(2.5)) and list(scene.sites.region) == ["", ""]
     one = "time,site,fx,fy,fz\n0.5,a,0,0,1\n0.5,b,0,0,1\n"
-    assert from_long_csv(*long_csv(tmp_path, one), fs=10.0).n_samples == 1
+    assert from_long_csv(*long_csv(tmp_path, one), fs=10.0, conditioning=None).n_samples == 1
     with pytest.raises(ValueError, match="single time stamp; pass fs"):
-        from_long_csv(*long_csv(tmp_path, one))
+        from_long_csv(*long_csv(tmp_path, one), conditioning=None)
 
 
 LONG_ERRORS = [
@@ -282,7 +282,7 @@ LONG_ERRORS = [
     (FORCES.replace("0,0.25,2", "0,inf,2"), SITES, None, "f.csv", r"column 'fy', line 4: non-finite value 'inf'"),
     (FORCES.replace("0,0.25,2", "0,x,2"), SITES, None, "f.csv", r"column 'fy', line 4: 'x' is not a number"),
     (FORCES.replace("0.01,a,0,0.1,1", "0.01,a,0,0.1,-1"), SITES, None, "f.csv",
-     r"column 'fz', line 5: negative normal force -1.0 N"),
+     r"column 'fz', line 5: negative normal force -1 N \(below the sensor-noise allowance of -0.13 N\)"),
     (FORCES.replace("0.01,a,0,0.1,1", "0.01,a,0,0.1"), SITES, None, "f.csv", "line 5 has 4 values but the header has 5"),
     (FORCES.replace("fz", "f_z"), SITES, None, "f.csv", "has no column 'fz'"),
     ("time,site,fx,fy,fz\n", SITES, None, "f.csv", "has a header but no data rows"),

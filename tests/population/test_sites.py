@@ -95,7 +95,7 @@ def test_multi_site_runs_do_not_depend_on_chunking_planning_or_engine(pop, chunk
 def test_streaming_multi_site_equals_offline(pop, cuts):
     sc = twist()
     offline = simulate(pop, sc, engine="direct", seed=2, quiet=True)
-    enc = Encoder(pop, sc.fs, seed=2, sites=sc.sites)
+    enc = Encoder(pop, sc.fs, seed=2, sites=sc.sites, conditioning=None)
     edges = [0] + sorted(cuts) + [sc.n_samples]
     outs = [enc.push(sc.site_forces[a:b]) for a, b in zip(edges[:-1], edges[1:])]
     np.testing.assert_array_equal(np.concatenate([o.afferent for o in outs]), offline.spike_afferent.values)

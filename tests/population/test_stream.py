@@ -30,7 +30,7 @@ def concat(outs):
 @given(cuts=st.lists(st.integers(1, N - 1), max_size=25, unique=True), engine=st.sampled_from(["direct"] * 3 + ["brian2"]))
 def test_any_chunking_equals_offline(setup, cuts, engine):
     pop, forces, offline = setup
-    enc = Encoder(pop, 1000.0, engine=engine, seed=3)
+    enc = Encoder(pop, 1000.0, engine=engine, seed=3, conditioning=None)
     edges = [0] + sorted(cuts) + [N]
     aff, t = concat([enc.push(forces[a:b]) for a, b in zip(edges[:-1], edges[1:])])
     np.testing.assert_array_equal(aff, offline[engine].spike_afferent.values)
@@ -45,7 +45,7 @@ def test_parallel_push_equals_offline(setup, monkeypatch, threads):
     monkeypatch.setattr(get_engine("direct"), "parallel_min_afferents", 1)
     monkeypatch.setenv("DDMM_NUM_THREADS", threads)
     pop, forces, offline = setup
-    enc = Encoder(pop, 1000.0, engine="direct", seed=3)
+    enc = Encoder(pop, 1000.0, engine="direct", seed=3, conditioning=None)
     aff, t = concat([enc.push(forces[a:a + 7]) for a in range(0, N, 7)])
     np.testing.assert_array_equal(aff, offline["direct"].spike_afferent.values)
     np.testing.assert_array_equal(t, offline["direct"].spike_time.values)
@@ -53,7 +53,7 @@ def test_parallel_push_equals_offline(setup, monkeypatch, threads):
 
 def test_bad_chunks_do_not_corrupt_the_state(setup):
     pop, forces, offline = setup
-    enc = Encoder(pop, 1000.0, engine="direct", seed=3)
+    enc = Encoder(pop, 1000.0, engine="direct", seed=3, conditioning=None)
     times = np.arange(N) / 1000.0
     outs = [enc.push(forces[:1000], times=times[:1000])]
     bad = forces[1000:1100].copy()
@@ -72,7 +72,7 @@ def test_bad_chunks_do_not_corrupt_the_state(setup):
 
 def test_reset_starts_over(setup):
     pop, forces, _ = setup
-    enc = Encoder(pop, 1000.0, engine="direct", seed=3)
+    enc = Encoder(pop, 1000.0, engine="direct", seed=3, conditioning=None)
     first = enc.push(forces[:800])
     enc.reset()
     again = enc.push(forces[:800])
@@ -116,7 +116,7 @@ def test_the_spike_cap_warning_survives_the_fused_path():
     scene = birznieks(90.0)
     with pytest.warns(SpikeCapWarning, match="consecutive steps"):
         simulate(pop, scene, engine="direct", quiet=True)
-    enc = Encoder(pop, scene.fs, seed=0)
+    enc = Encoder(pop, scene.fs, seed=0, conditioning=None)
     with pytest.warns(SpikeCapWarning):
         enc.push(np.column_stack([scene.fx, scene.fy, scene.fz])[:200])
     with warnings.catch_warnings():
