@@ -1,4 +1,4 @@
-"""``ddmm reproduce {table2,table3,fig8,all}``: the paper's tables and figures."""
+"""``ddmm reproduce {table2,table3,fig8,all,table4}``: the paper's tables and figures, cell by cell."""
 
 from __future__ import annotations
 
@@ -6,120 +6,138 @@ import json
 import sys
 import warnings
 
+from ddmm.experiments.cmd_recordings import add_recording_options
 from ddmm.experiments.io import ensure_out_dir, save_figure, save_json
-from ddmm.experiments.paper_values import PAPER_TABLE2, PAPER_TABLE3
 
-__all__ = ["register", "format_table2", "format_table3", "format_fig8"]
+__all__ = ["register", "format_cells", "format_fig8"]
 
-_HUMAN_DSI = {"SAI": "0.23 ± 0.18", "RAI": "0.24 ± 0.18", "RAII": "not reported"}
+_WHAT = ("table2", "table3", "fig8", "all", "table4")
 
 
 def register(sub) -> None:
     """Add the ``reproduce`` subcommand to an argparse subparsers object."""
-    p = sub.add_parser("reproduce", help="reproduce the paper's Table II, Table III and Fig. 8")
-    p.add_argument("what", choices=("table2", "table3", "fig8", "all"))
+    from ddmm.experiments.paper_calibration import CALIBRATIONS
+
+    p = sub.add_parser("reproduce", help="reproduce the paper's Tables II-IV and Figs 6-8, cell by cell")
+    p.add_argument("what", choices=_WHAT, help="table4 runs the pilot's analysis on --scene (a recording)")
+    p.add_argument("--calibration", choices=tuple(CALIBRATIONS), default="paper",
+                   help="paper (default): the unpublished constants fitted type by type to Table III; "
+                        "gains-only: only the gains, fitted to the CMM column (eq. 17 reading, contact-mean SF)")
     p.add_argument("--engine", choices=("brian2", "direct"), default="brian2")
-    p.add_argument("--no-shear", choices=("pass", "block"), default="pass",
-                   help="reading of eq. 17 below F_TH: pass (AF=1, default) or block (AF=0)")
+    p.add_argument("--no-shear", choices=("pass", "block"), default=None,
+                   help="override every type's reading of eq. 17 below F_TH: pass (AF=1) or block (AF=0)")
+    p.add_argument("--scene", metavar="FILE.csv", help="table4: the press-push-lift recording (e.g. the authors')")
     p.add_argument("--out", metavar="DIR", help="write PNG figures and reproduce.json here")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of tables")
+    add_recording_options(p)
     p.set_defaults(func=run)
 
 
-def format_table2(result: dict) -> str:
-    """Markdown table of our PRSI beside the paper's."""
-    from ddmm.experiments.reproduce import PROFILES
-    from ddmm.models.afferent_types import PAPER_TYPES
-    prsi = result["prsi"]
-    lines = ["| type | " + " | ".join(f"{p} ours (paper)" for p in PROFILES) + " | human DSI |",
-             "|---" * (len(PROFILES) + 2) + "|"]
-    for t in PAPER_TYPES:
-        cells = [f"{prsi[p][t]:.2f} ({PAPER_TABLE2[p][t]:.2f})" for p in PROFILES]
-        lines.append(f"| {t} | " + " | ".join(cells) + f" | {_HUMAN_DSI[t]} |")
+def _number(value) -> str:
+    return "" if value is None else f"{value:.3g}" if abs(value) < 10 else f"{value:.1f}"
+
+
+def format_cells(cells: list) -> str:
+    """Markdown table of every cell: paper, model, relative error and role."""
+    lines = ["| table | type | profile | row | paper | model | rel. error | role |", "|---|---|---|---|---|---|---|---|"]
+    for c in cells:
+        rel = "" if c["rel_error"] is None else "inf" if c["rel_error"] == float("inf") else f"{c['rel_error']:+.0%}"
+        lines.append(f"| {c['table']} | {c['type']} | {c['profile']} | {c['row']} | {_number(c['paper'])} | "
+                     f"{_number(c['model'])} | {rel} | {c['role']} |")
     return "\n".join(lines)
 
 
-def format_table3(result: dict) -> str:
-    """Markdown table of our SF at 75/255 deg beside the paper's."""
-    from ddmm.experiments.reproduce import PROFILES
-    from ddmm.models.afferent_types import PAPER_TYPES
-    sf = result["sf"]
-    lines = ["| type | " + " | ".join(f"{p} 75° / 255° ours (paper)" for p in PROFILES) + " |",
-             "|---" * (len(PROFILES) + 1) + "|"]
-    for t in PAPER_TYPES:
-        cells = []
-        for p in PROFILES:
-            a, b = sf[p][t]["75"], sf[p][t]["255"]
-            pa, pb = PAPER_TABLE3[p][t]
-            cells.append(f"{a:.1f} / {b:.1f} ({pa:g} / {pb:g})")
-        lines.append(f"| {t} | " + " | ".join(cells) + " |")
+def format_fig8(peaks: list) -> str:
+    """Markdown table of Fig. 8's peaks (a prediction: in no fit)."""
+    lines = ["| type | profile | peak theta_T | off alignment (theta_R = 90°) |", "|---|---|---|---|"]
+    for p in peaks:
+        peak = "flat" if p["peak_theta_t"] is None else f"{p['peak_theta_t']:g}°"
+        off = "" if p["off_alignment_deg"] is None else f"{p['off_alignment_deg']:g}°"
+        lines.append(f"| {p['type']} | {p['profile']} | {peak} | {off} |")
     return "\n".join(lines)
 
 
-def format_fig8(result: dict) -> str:
-    """Markdown summary of Fig. 8: peak angle, range and bipolar symmetry."""
-    from ddmm.experiments.reproduce import PROFILES
-    from ddmm.models.afferent_types import PAPER_TYPES
-    sf = result["sf"]
-    lines = ["| profile | type | peak theta_T | SF min-max (pulses/s) | SF(θ) = SF(θ+180°) |",
-             "|---|---|---|---|---|"]
-    for p in PROFILES:
-        for t in PAPER_TYPES:
-            curve = {float(a): v for a, v in sf[p][t].items()}
-            peak = max(curve, key=curve.get)
-            sym = all(curve[a] == curve[(a + 180.0) % 360.0] for a in curve)
-            lines.append(f"| {p} | {t} | {peak:g}° | {min(curve.values()):.1f}-{max(curve.values()):.1f}"
-                         f" | {'yes' if sym else 'no'} |")
-    return "\n".join(lines)
+def _calibration(args):
+    import dataclasses
+
+    from ddmm.experiments.paper_calibration import CALIBRATIONS, FITTED_CELLS
+    from ddmm.experiments.paper_cells import with_engine
+    calibration = with_engine(CALIBRATIONS[args.calibration], args.engine)
+    if args.no_shear is not None:
+        calibration = {k: dataclasses.replace(c, no_shear=args.no_shear) for k, c in calibration.items()}
+    return calibration, FITTED_CELLS[args.calibration]
 
 
-def _write_figures(out_dir, what, config, result) -> list[str]:
+def _describe(calibration) -> str:
+    rows = []
+    for kind, c in calibration.items():
+        rows.append(f"{kind}: reading {c.no_shear}, SF {c.sf_definition}"
+                    + (f" ({c.bin_s:g} s bins)" if c.sf_definition == "peak_bin" else "")
+                    + f", ramps {c.ramp_s:g}/{c.lift_ramp_s if c.lift_ramp_s is not None else c.ramp_s:g} s, "
+                      f"shear onset {c.shear_delay_s * 1e3:g} ms (Birznieks {c.birznieks_shear_delay_s * 1e3:g} ms)")
+    return "\n".join(f"- {r}" for r in rows)
+
+
+def _write_figures(out_dir, what, calibration, result) -> list[str]:
     from ddmm.experiments.plotting import plot_response, plot_sf_vs_theta  # matplotlib is slow to import
     from ddmm.experiments.reproduce import FIGURE_SCENES, PROFILES, response_data
 
     written = []
     if what in ("fig8", "all"):
-        sf = result["fig8"]["sf"] if what == "all" else result["sf"]
+        curves = result["curves"]
+        sf = {p: {k: curves[k][p] for k in curves} for p in PROFILES}
         written.append(str(save_figure(plot_sf_vs_theta(sf), out_dir / "fig8.png")))
-    if what in ("table2", "table3", "all"):
-        names = {"table2": ("fig6",), "table3": ("fig7",), "all": ("fig6", "fig7")}[what]
-        for name in names:
-            make_scene, angles = FIGURE_SCENES[name]
+    names = {"table2": ("fig6",), "table3": ("fig7",), "all": ("fig6", "fig7")}.get(what, ())
+    for name in names:
+        scene_of, angles = FIGURE_SCENES[name]
+        for kind, config in calibration.items():
             for profile in PROFILES:
-                data = response_data(make_scene(), profile, angles, config)
-                fig = plot_response(data, title=f"{name}: {profile} (no_shear={config.no_shear})")
-                written.append(str(save_figure(fig, out_dir / f"{name}_{profile}.png")))
+                data = response_data(scene_of(config), profile, angles, config, types=(kind,))
+                fig = plot_response(data, title=f"{name}: {kind}, {profile} (no_shear={config.no_shear})")
+                written.append(str(save_figure(fig, out_dir / f"{name}_{kind}_{profile}.png")))
     return written
 
 
-def run(args) -> int:
-    from ddmm.experiments.reproduce import ReproConfig, fig8, reproduce_all, table2, table3
+def _compute(args, calibration, fitted) -> dict:
+    from ddmm.experiments.paper_cells import reproduce_cells
     from ddmm.models.engines import SpikeCapWarning
-    config = ReproConfig(engine=args.engine, no_shear=args.no_shear)
-    out_dir = ensure_out_dir(args.out) if args.out else None
-    compute = {"table2": table2, "table3": table3, "fig8": fig8, "all": reproduce_all}[args.what]
+    if args.what == "table4":
+        from ddmm.experiments.paper_table4 import table4
+        return table4(args.scene, calibration, args)
+    tables = ("table2", "table3", "fig8") if args.what == "all" else (args.what,)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", SpikeCapWarning)
-        result = compute(config)
+        result = reproduce_cells(calibration, fitted, tables)
     if any(issubclass(w.category, SpikeCapWarning) for w in caught):
-        print("note: the paper's linear RA currents drive some afferents at one spike per step on Birznieks' "
-              "32 N/s ramp (docs/model.md, 'How far we are from the paper')", file=sys.stderr)
+        print("note: the paper's linear RA currents drive some afferents at one spike per step on a fast ramp "
+              "(docs/model.md, 'How far the gains-only calibration is from the paper')", file=sys.stderr)
+    return result
+
+
+def run(args) -> int:
+    if args.what == "table4" and args.scene is None:
+        raise ValueError("ddmm reproduce table4 needs --scene FILE.csv: the press-push-lift recording to analyse")
+    if args.what != "table4" and args.scene is not None:
+        raise ValueError(f"--scene goes with 'ddmm reproduce table4' only; {args.what} uses the paper's synthetic "
+                         "scenes")
+    calibration, fitted = _calibration(args)
+    out_dir = ensure_out_dir(args.out) if args.out else None
+    result = _compute(args, calibration, fitted)
+    public = {k: v for k, v in result.items() if k in ("cells", "fig8")}
     if args.json:
-        print(json.dumps(result))
+        print(json.dumps(public))
     else:
-        parts = {"table2": result if args.what == "table2" else result.get("table2"),
-                 "table3": result if args.what == "table3" else result.get("table3"),
-                 "fig8": result if args.what == "fig8" else result.get("fig8")}
-        header = f"engine={config.engine}, no_shear={config.no_shear}, dt={config.dt * 1e3:g} ms, k={config.k:g}"
-        print(f"# DDMM reproduction ({header})\n")
-        for name, fmt, title in (("table2", format_table2, "Table II: PRSI, Birznieks scene, theta_R = 90°"),
-                                 ("table3", format_table3, "Table III: SF (pulses/s), press-push-lift"),
-                                 ("fig8", format_fig8, "Fig. 8: SF against theta_T")):
-            if parts[name] is not None:
-                print(f"## {title}\n\n{fmt(parts[name])}\n")
+        print(f"# DDMM reproduction: calibration {args.calibration}, engine {args.engine}, dt 0.1 ms, k 3\n")
+        print(_describe(calibration) + "\n")
+        print("Roles: fitted = an objective of the calibration's fit; reproduced = zero or equal by symmetry; "
+              "prediction = in no fit.\n")
+        if public.get("cells"):
+            print(format_cells(public["cells"]) + "\n")
+        if "fig8" in public:
+            print("## Fig. 8: SF against theta_T (prediction)\n\n" + format_fig8(public["fig8"]) + "\n")
     if out_dir is not None:
         save_json(result, out_dir / "reproduce.json")
-        for path in _write_figures(out_dir, args.what, config, result):
+        for path in _write_figures(out_dir, args.what, calibration, result):
             if not args.json:
                 print(f"wrote {path}")
     return 0

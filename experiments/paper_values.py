@@ -9,6 +9,7 @@ __all__ = [
     "PAPER_RADII_K3",
     "PAPER_TABLE2",
     "PAPER_TABLE3",
+    "PAPER_TABLE4",
     "HUMAN_DSI",
     "HUMAN_TUNED_FRACTION",
     "HUMAN_DIRECTION_THRESHOLD_DEG",
@@ -40,6 +41,15 @@ PAPER_TABLE3 = {
     "broad": {"SAI": (47.5, 10.0), "RAI": (20.0, 7.5), "RAII": (20.0, 7.5)},
     "bipolar": {"SAI": (37.5, 37.5), "RAI": (17.5, 17.5), "RAII": (15.0, 15.0)},
     "cmm": {"SAI": (47.5, 47.5), "RAI": (15.0, 15.0), "RAII": (10.0, 10.0)},
+}
+
+#: Paper Table IV: SF (pulses/s) of the pilot recording (§V, 100 Hz force plate, mean of 5 trials), aligned
+#: (75 deg) / misaligned (255 deg in the table's header, 225 deg in the text).
+PAPER_TABLE4 = {
+    "selective": {"SAI": (13.4, 4.5), "RAI": (2.5, 1.0), "RAII": (1.0, 0.5)},
+    "broad": {"SAI": (16.11, 2.66), "RAI": (3.0, 0.5), "RAII": (1.5, 0.0)},
+    "bipolar": {"SAI": (13.05, 13.05), "RAI": (2.5, 2.5), "RAII": (0.5, 0.5)},
+    "cmm": {"SAI": (17.8, 17.8), "RAI": (3.0, 3.0), "RAII": (1.0, 1.0)},
 }
 
 #: Human DSI (eq. 7), mean and SD, Birznieks et al. 2001 as the paper reports it.

@@ -62,15 +62,16 @@ def plot_response(data: dict, *, title: str = "", bin_s: float | None = None) ->
     duration = float(time[-1] + (time[1] - time[0] if time.size > 1 else 0.0))
     bin_s = duration / 30.0 if bin_s is None else bin_s
     conds = data["conditions"]
-    fig = Figure(figsize=(5.0 * len(conds), 9.0), layout="constrained")
-    axes = fig.subplots(2 + len(PAPER_TYPES), len(conds), sharex=True, squeeze=False)
+    kinds = [k for k in PAPER_TYPES if k in conds[0]["spikes"]]  # the types the data carry
+    fig = Figure(figsize=(5.0 * len(conds), 3.6 + 1.8 * len(kinds)), layout="constrained")
+    axes = fig.subplots(2 + len(kinds), len(conds), sharex=True, squeeze=False)
     for col, cond in enumerate(conds):
         _plot_forces(axes[0, col], time, data["forces"])
         axes[0, col].set_title(cond["label"], fontsize=10)
         axes[1, col].plot(time, cond["af"], color="purple", lw=1.2)
         axes[1, col].set_ylim(-0.05, 1.05)
         axes[1, col].set_ylabel("AF(t)")
-        for row, kind in enumerate(PAPER_TYPES, start=2):
+        for row, kind in enumerate(kinds, start=2):
             _plot_spikes(axes[row, col], np.asarray(cond["spikes"][kind]), duration, bin_s,
                          _TYPE_COLOURS[kind], kind)
         axes[-1, col].set_xlabel("time (s)")

@@ -51,6 +51,15 @@ class ReproConfig:
         NAP sharpness (the paper uses k = 3).
     current_params : CurrentParams
         Gains and derivative filter.
+    sf_definition : {"contact_mean", "peak_bin"}
+        The reading of Table III's SF (`ddmm.models.metrics.SF_DEFINITIONS`).
+    bin_s : float
+        Bin length in seconds of the ``peak_bin`` reading.
+    ramp_s, lift_ramp_s, shear_delay_s : float
+        Press-push-lift's press/push ramps, its lift ramp (None: ``ramp_s``)
+        and the shear's onset into the push ramp, s (`press_push_lift`).
+    birznieks_shear_delay_s : float
+        The shear's onset into Birznieks' loading ramp, s (`birznieks`).
     """
 
     engine: str = "brian2"
@@ -58,13 +67,29 @@ class ReproConfig:
     dt: float = 1e-4
     k: float = 3.0
     current_params: CurrentParams = CurrentParams()
+    sf_definition: str = "contact_mean"
+    bin_s: float = 0.4
+    ramp_s: float = 2.0
+    lift_ramp_s: float | None = None
+    shear_delay_s: float = 0.0
+    birznieks_shear_delay_s: float = 0.0
+
+    def birznieks(self, theta_r: float = 90.0) -> Scene:
+        """The Table II scene (Birznieks' ramp-hold-release) with this configuration's shear onset."""
+        return birznieks(theta_r, shear_delay_s=self.birznieks_shear_delay_s)
+
+    def press_push_lift(self, theta_r: float = 90.0) -> Scene:
+        """The Table III / Fig. 8 scene with this configuration's ramps and shear onset."""
+        return press_push_lift(theta_r, ramp_s=self.ramp_s, lift_ramp_s=self.lift_ramp_s,
+                               shear_delay_s=self.shear_delay_s)
 
 
 def _model_profile(profile: str) -> str:
     return UNTUNED if profile == "cmm" else profile
 
 
-def scene_sf(scene: Scene, theta_ts, config: ReproConfig = ReproConfig(), profiles=PROFILES):
+def scene_sf(scene: Scene, theta_ts, config: ReproConfig = ReproConfig(), profiles=PROFILES, types=PAPER_TYPES,
+             definition: str | None = None):
     """SF (pulses/s) of every profile x type x theta_T on one scene.
 
     Returns
@@ -75,22 +100,23 @@ def scene_sf(scene: Scene, theta_ts, config: ReproConfig = ReproConfig(), profil
         The spikes, columns ordered profile-major, then type, then angle.
     """
     theta_ts = np.asarray(theta_ts, dtype=float)
-    blocks, types = [], []
+    blocks, column_types = [], []
     for profile in profiles:
-        for kind in PAPER_TYPES:
+        for kind in types:
             blocks.append(compute_currents(
                 scene.fx, scene.fy, scene.fz, fs=scene.fs, afferent_type=kind,
                 profile=_model_profile(profile), theta_t=theta_ts, k=config.k,
                 no_shear=config.no_shear, current_params=config.current_params,
             ))
-            types += [kind] * theta_ts.size
+            column_types += [kind] * theta_ts.size
     current = np.hstack(blocks)
-    result = integrate(current, fs=scene.fs, dt=config.dt, afferent_type=np.array(types, object),
+    result = integrate(current, fs=scene.fs, dt=config.dt, afferent_type=np.array(column_types, object),
                        engine=config.engine)
     sf = spiking_frequency(result.step, current.shape[1], fz=scene.fz, fs=scene.fs,
-                           substeps=substeps_for(scene.fs, config.dt), afferent=result.afferent)
-    sf = sf.reshape(len(profiles), len(PAPER_TYPES), theta_ts.size)
-    table = {p: {t: sf[i, j] for j, t in enumerate(PAPER_TYPES)} for i, p in enumerate(profiles)}
+                           substeps=substeps_for(scene.fs, config.dt), afferent=result.afferent,
+                           definition=definition or config.sf_definition, bin_s=config.bin_s)
+    sf = sf.reshape(len(profiles), len(types), theta_ts.size)
+    table = {p: {t: sf[i, j] for j, t in enumerate(types)} for i, p in enumerate(profiles)}
     return table, result
 
 
@@ -143,7 +169,7 @@ def reproduce_all(config: ReproConfig = ReproConfig()) -> dict:
     return {"table2": table2(config), "table3": table3(config, sub), "fig8": fig8(config, sf)}
 
 
-def response_data(scene: Scene, profile: str, angles, config: ReproConfig = ReproConfig()) -> dict:
+def response_data(scene: Scene, profile: str, angles, config: ReproConfig = ReproConfig(), types=PAPER_TYPES) -> dict:
     """Data for a Fig. 6/7 panel: forces, AF(t) and spike times per type and theta_T.
 
     Parameters
@@ -154,25 +180,29 @@ def response_data(scene: Scene, profile: str, angles, config: ReproConfig = Repr
         A profile of `PROFILES`.
     angles : sequence of (label, theta_T in deg)
         Conditions, e.g. ``[("aligned", 90.0), ("misaligned", 180.0)]``.
+    config : ReproConfig
+        Reading, gains and SF definition.
+    types : sequence of str
+        The paper types to simulate (each condition's ``spikes`` has these keys).
     """
     from ddmm.models.attenuation import attenuation_factor
 
     thetas = [a for _, a in angles]
-    _, result = scene_sf(scene, thetas, config, profiles=(profile,))
+    _, result = scene_sf(scene, thetas, config, profiles=(profile,), types=types)
     af = attenuation_factor(scene.fx, scene.fy, thetas, _model_profile(profile), config.k,
                             no_shear=config.no_shear)
     conditions = []
     for j, (label, theta) in enumerate(angles):
         spikes = {kind: result.time[result.afferent == i * len(angles) + j]
-                  for i, kind in enumerate(PAPER_TYPES)}
+                  for i, kind in enumerate(types)}
         conditions.append({"label": f"{profile}, {label} (theta_T = {theta:g} deg)",
                            "af": af[:, j], "spikes": spikes})
     return {"time": scene.time, "forces": {"fx": scene.fx, "fy": scene.fy, "fz": scene.fz},
             "conditions": conditions}
 
 
-#: Conditions of paper Figs 6 (Birznieks scene) and 7 (press-push-lift).
+#: Conditions of paper Figs 6 (Birznieks scene) and 7 (press-push-lift): the scene of a `ReproConfig`, the angles.
 FIGURE_SCENES = {
-    "fig6": (lambda: birznieks(90.0), (("aligned", 90.0), ("misaligned", 180.0))),
-    "fig7": (lambda: press_push_lift(90.0), (("near-aligned", 75.0), ("near-misaligned", 255.0))),
+    "fig6": (lambda config: config.birznieks(90.0), (("aligned", 90.0), ("misaligned", 180.0))),
+    "fig7": (lambda config: config.press_push_lift(90.0), (("near-aligned", 75.0), ("near-misaligned", 255.0))),
 }

@@ -253,13 +253,18 @@ def _check_site_fz(forces, sites, fs) -> None:
                          f"{sites.site_id[j]!r}, t = {k / fs} s")
 
 
+def _check_delay(shear_delay_s, ramp_s) -> None:
+    if not (isinstance(shear_delay_s, (int, float)) and 0.0 <= shear_delay_s < ramp_s):
+        raise ValueError(f"shear_delay_s must be in [0, ramp_s = {ramp_s:g}) s, got {shear_delay_s!r}")
+
+
 def _samples(duration: float, fs: float) -> np.ndarray:
     n = int(round(duration * fs))
     return np.arange(n) / fs
 
 
 def birznieks(direction_deg: float | None = 90.0, *, normal_n: float = 4.0, angle_deg: float = 20.0,
-              ramp_s: float = 0.125, hold_s: float = 0.25, fs: float = DEFAULT_FS,
+              ramp_s: float = 0.125, hold_s: float = 0.25, shear_delay_s: float = 0.0, fs: float = DEFAULT_FS,
               contact: Contact | None = None) -> Scene:
     """Ramp-hold-release of Birznieks et al. 2001 (paper Fig. 6a, docs/model.md §1.9).
 
@@ -276,6 +281,11 @@ def birznieks(direction_deg: float | None = 90.0, *, normal_n: float = 4.0, angl
     normal_n, angle_deg, ramp_s, hold_s, fs, contact
         Normal force (N), inclination (deg), ramp and plateau lengths (s),
         sample rate (Hz) and optional contact geometry.
+    shear_delay_s : float
+        The tangential force starts this long after the normal force and
+        reaches its plateau with it (s, in [0, ``ramp_s``); default 0: both
+        together, as drawn in paper Fig. 6a).  A parameter of the paper
+        calibration (`ddmm.experiments.paper_calibration`).
 
     Examples
     --------
@@ -283,6 +293,7 @@ def birznieks(direction_deg: float | None = 90.0, *, normal_n: float = 4.0, angl
     >>> round(float(s.fy.max()), 3), s.duration
     (1.456, 0.5)
     """
+    _check_delay(shear_delay_s, ramp_s)
     t = _samples(2 * ramp_s + hold_s, fs)
     knots = [0.0, ramp_s, ramp_s + hold_s, 2 * ramp_s + hold_s]
     profile = np.interp(t, knots, [0.0, 1.0, 1.0, 0.0])
@@ -291,7 +302,8 @@ def birznieks(direction_deg: float | None = 90.0, *, normal_n: float = 4.0, angl
         fx = fy = np.zeros_like(fz)
         name = "normal"
     else:
-        shear = normal_n * np.tan(np.deg2rad(angle_deg)) * profile
+        shear_profile = np.interp(t, [0.0, shear_delay_s, *knots[1:]], [0.0, 0.0, 1.0, 1.0, 0.0])
+        shear = normal_n * np.tan(np.deg2rad(angle_deg)) * shear_profile
         rad = np.deg2rad(direction_deg)
         fx, fy = shear * np.cos(rad), shear * np.sin(rad)
         name = f"birznieks_{direction_deg:g}"
@@ -301,18 +313,22 @@ def birznieks(direction_deg: float | None = 90.0, *, normal_n: float = 4.0, angl
 
 
 def press_push_lift(theta_r: float = 90.0, *, press_n: float = 3.0, push_n: float = 6.0,
-                    shear_n: float | None = None, ramp_s: float = 2.0, fs: float = DEFAULT_FS,
-                    contact: Contact | None = None) -> Scene:
+                    shear_n: float | None = None, ramp_s: float = 2.0, lift_ramp_s: float | None = None,
+                    shear_delay_s: float = 0.0, fs: float = DEFAULT_FS, contact: Contact | None = None) -> Scene:
     """Press-push-lift of paper §IV.B (Fig. 7a), with documented choices.
 
     * 0-5 s: no contact.
     * Stage 1 (5-15 s): ramp F_Z to ``press_n`` (3 N) over ``ramp_s``, hold.
-    * Stage 2 (15-25 s): ramp F_Z to ``push_n`` (6 N) and the shear to
-      ``shear_n`` in direction ``theta_r`` over ``ramp_s``, hold.  The default
-      shear is ``push_n * tan 20 deg`` (about 2.18 N), Birznieks' inclination.
-    * Stage 3 (25-30 s): ramp everything to 0 over ``ramp_s`` (lift), rest.
+    * Stage 2 (15-25 s): ramp F_Z to ``push_n`` (6 N) over ``ramp_s`` and the
+      shear to ``shear_n`` in direction ``theta_r`` from ``shear_delay_s``
+      into that ramp to its end, hold.  The default shear is
+      ``push_n * tan 20 deg`` (about 2.18 N), Birznieks' inclination.
+    * Stage 3 (25-30 s): ramp everything to 0 over ``lift_ramp_s`` (default
+      ``ramp_s``; at most 5 s), rest.
 
-    Each stage is a dynamic period (D, the ramp) then a static one (S).
+    Each stage is a dynamic period (D, the ramp) then a static one (S).  The
+    paper gives neither ramp length nor the shear's onset: they are
+    parameters of the paper calibration (`ddmm.experiments.paper_calibration`).
 
     Examples
     --------
@@ -321,16 +337,21 @@ def press_push_lift(theta_r: float = 90.0, *, press_n: float = 3.0, push_n: floa
     (30.0, 6.0)
     """
     shear_n = push_n * np.tan(np.deg2rad(20.0)) if shear_n is None else shear_n
+    lift_s = ramp_s if lift_ramp_s is None else lift_ramp_s
+    for name, value, top in (("ramp_s", ramp_s, 10.0), ("lift_ramp_s", lift_s, 5.0)):
+        if not (isinstance(value, (int, float)) and 0.0 < value <= top):
+            raise ValueError(f"{name} must be in (0, {top:g}] s, got {value!r}")
+    _check_delay(shear_delay_s, ramp_s)
     t = _samples(30.0, fs)
-    knots = [0.0, 5.0, 5.0 + ramp_s, 15.0, 15.0 + ramp_s, 25.0, 25.0 + ramp_s, 30.0]
+    knots = [0.0, 5.0, 5.0 + ramp_s, 15.0, 15.0 + ramp_s, 25.0, 25.0 + lift_s, 30.0]
     fz = np.interp(t, knots, [0, 0, press_n, press_n, push_n, push_n, 0, 0])
-    shear = np.interp(t, knots, [0, 0, 0, 0, shear_n, shear_n, 0, 0])
+    shear = np.interp(t, [*knots[:4], 15.0 + shear_delay_s, *knots[4:]], [0, 0, 0, 0, 0, shear_n, shear_n, 0, 0])
     rad = np.deg2rad(theta_r)
     stages = tuple(
         Stage(label, a, b) for label, a, b in (
             ("stage1_dynamic", 5.0, 5.0 + ramp_s), ("stage1_static", 5.0 + ramp_s, 15.0),
             ("stage2_dynamic", 15.0, 15.0 + ramp_s), ("stage2_static", 15.0 + ramp_s, 25.0),
-            ("stage3_dynamic", 25.0, 25.0 + ramp_s), ("stage3_static", 25.0 + ramp_s, 30.0),
+            ("stage3_dynamic", 25.0, 25.0 + lift_s), ("stage3_static", 25.0 + lift_s, 30.0),
         )
     )
     return Scene(shear * np.cos(rad), shear * np.sin(rad), fz, fs, f"press_push_lift_{theta_r:g}",

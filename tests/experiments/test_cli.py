@@ -20,21 +20,24 @@ def test_engines_print_identical_json(capsys):
         assert code == 0
         outputs.append(out)
     assert outputs[0] == outputs[1]
-    assert set(json.loads(outputs[0])) == {"table2", "table3", "fig8"}
+    assert set(json.loads(outputs[0])) == {"cells", "fig8"}
 
 
-@pytest.mark.parametrize("what,key", [("table2", "prsi"), ("table3", "sf"), ("fig8", "sf")])
-def test_json_per_table(capsys, what, key):
+@pytest.mark.parametrize("what,keys,tables", [("table2", ["cells"], {"II"}), ("table3", ["cells"], {"III"}),
+                                              ("fig8", ["cells", "fig8"], set())])
+def test_json_per_table(capsys, what, keys, tables):
     code, out, _ = run(capsys, "reproduce", what, "--json", "--engine", "direct", "--no-shear", "block")
-    assert code == 0 and list(json.loads(out)) == [key]
+    result = json.loads(out)
+    assert code == 0 and list(result) == keys and {c["table"] for c in result["cells"]} == tables
 
 
 def test_tables_and_figures_written(capsys, tmp_path):
     code, out, _ = run(capsys, "reproduce", "all", "--engine", "direct", "--out", str(tmp_path))
     assert code == 0
-    assert "Table II" in out and "0.38" in out and "Table III" in out
+    assert "| II | SAI | selective | PRSI | 0.38 |" in out and "| III | RAII | cmm | SF (75°) | 10.0 |" in out
+    assert "Fig. 8" in out and "reading block" in out
     names = {p.name for p in tmp_path.iterdir()}
-    expected = {"fig8.png", "reproduce.json"} | {f"fig{n}_{p}.png" for n in (6, 7)
+    expected = {"fig8.png", "reproduce.json"} | {f"fig{n}_{t}_{p}.png" for n in (6, 7) for t in ("SAI", "RAI", "RAII")
                                                  for p in ("selective", "broad", "bipolar", "cmm")}
     assert expected <= names
     assert all((tmp_path / n).stat().st_size > 10_000 for n in expected if n.endswith(".png"))
@@ -43,7 +46,7 @@ def test_tables_and_figures_written(capsys, tmp_path):
 
 @pytest.mark.parametrize("argv", [
     ["reproduce", "table9"], ["reproduce", "all", "--engine", "nest"],
-    ["reproduce", "all", "--no-shear", "maybe"],
+    ["reproduce", "all", "--no-shear", "maybe"], ["reproduce", "all", "--calibration", "mine"],
 ])
 def test_bad_arguments_exit_2(capsys, argv):
     with pytest.raises(SystemExit) as exc:

@@ -80,3 +80,26 @@ def test_csv_errors(tmp_path, text, match):
 def test_csv_negative_fz_can_be_clipped(tmp_path):
     s = from_csv(write(tmp_path, "time,fx,fy,fz\n0,0,0,-0.01\n0.01,0,0,1\n"), negative_fz="clip", conditioning=None)
     assert s.fz.min() == 0.0
+
+
+def test_reproduction_scene_ramps_and_shear_onset():
+    s = press_push_lift(90.0, ramp_s=0.5, lift_ramp_s=1.0, shear_delay_s=0.2)
+    t = s.time
+    assert np.all(s.fy[(t >= 15.0) & (t <= 15.2)] == 0.0) and s.fy[t > 15.2][0] > 0.0
+    assert s.fy[(t > 15.5) & (t < 25)].min() == pytest.approx(6.0 * np.tan(np.deg2rad(20.0)))
+    assert s.fz[(t > 25.99) & (t < 26.0)].max() < 0.1 and np.all(s.fz[t >= 26.0] == 0.0)
+    assert [(st.start, st.end) for st in s.stages][4] == (25.0, 26.0)
+    b = birznieks(90.0, shear_delay_s=0.05)
+    assert np.all(b.fy[b.time <= 0.05] == 0.0) and b.fy.max() == pytest.approx(birznieks(90.0).fy.max())
+    np.testing.assert_array_equal(press_push_lift().fy, press_push_lift(shear_delay_s=0.0, lift_ramp_s=2.0).fy)
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    ({"shear_delay_s": 2.0}, r"shear_delay_s must be in \[0, ramp_s = 2\) s, got 2.0"),
+    ({"shear_delay_s": -0.1}, "shear_delay_s must be in"),
+    ({"lift_ramp_s": 6.0}, r"lift_ramp_s must be in \(0, 5\] s, got 6.0"),
+    ({"ramp_s": 0.0}, r"ramp_s must be in \(0, 10\] s"),
+])
+def test_reproduction_scene_bad_parameters(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        press_push_lift(**kwargs)
