@@ -3,15 +3,42 @@
 from __future__ import annotations
 
 import argparse
+import difflib
+import re
 import sys
 
 __all__ = ["build_parser", "main"]
 
 
+def _did_you_mean(word: str, candidates) -> str:
+    match = difflib.get_close_matches(word, list(candidates), n=1, cutoff=0.6)
+    return f" (did you mean {match[0]}?)" if match else ""
+
+
 class _Parser(argparse.ArgumentParser):
-    """An ArgumentParser whose usage errors are one line and exit status 2."""
+    """An ArgumentParser whose usage errors are one line and exit status 2, with a "did you mean" for typos."""
+
+    def parse_args(self, args=None, namespace=None):
+        args, extras = self.parse_known_args(args, namespace)
+        if extras:
+            parser = self._subcommand(args)
+            options = [o for action in parser._actions for o in action.option_strings]
+            unknown = next((e for e in extras if e.startswith("-")), "")
+            hint = _did_you_mean(unknown.split("=")[0], options) if unknown else ""
+            parser.error(f"unrecognized arguments: {' '.join(extras)}{hint}")
+        return args
+
+    def _subcommand(self, args) -> argparse.ArgumentParser:
+        """The parser of the subcommand ``args`` names (self if none)."""
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction) and getattr(args, action.dest, None) in action.choices:
+                return action.choices[getattr(args, action.dest)]
+        return self
 
     def error(self, message):
+        choice = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+        if choice:  # a mistyped subcommand or option value
+            message += _did_you_mean(choice.group(1), re.findall(r"'([^']*)'", choice.group(2)))
         self.exit(2, f"ddmm: error: {message} (see '{self.prog} --help')\n")
 
 

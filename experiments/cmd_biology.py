@@ -79,6 +79,11 @@ def _fmt(v, pct=False):
     return f"{100 * v:.1f}%" if pct else f"{v:.3f}"
 
 
+def _row_label(kind: str) -> str:
+    """A tuning table row's label: a type, or the pooled rows (the human 86% pools SA-I, SA-II and FA-I)."""
+    return {"recorded": "SA-I + SA-II + FA-I", "all": "all four types"}.get(kind) or type_label(kind)
+
+
 def run_tuning(args) -> int:
     out_dir = ensure_out_dir(args.out) if args.out else None
     tuning, summary = run_tuning_stats(args.population, args.seed, args.trials, args.engine, args.correction)
@@ -94,7 +99,7 @@ def run_tuning(args) -> int:
             ref_f = TUNING_REFERENCE["tuned_fraction"][kind]
             d = summary["dsi"].get(kind)
             ref_d = TUNING_REFERENCE["dsi"].get(kind, "")
-            print(f"| {type_label(kind)} | {_fmt(summary['tuned_fraction'][kind], True)} | {_fmt(ref_f, True)} | "
+            print(f"| {_row_label(kind)} | {_fmt(summary['tuned_fraction'][kind], True)} | {_fmt(ref_f, True)} | "
                   + (f"{d['mean']:.2f} ± {d['sd']:.2f}" if isinstance(d, dict) else (d or ""))
                   + " | " + (f"{ref_d['mean']} ± {ref_d['sd']}" if isinstance(ref_d, dict) else str(ref_d)) + " |")
     if out_dir is not None:

@@ -11,7 +11,10 @@ from ddmm.experiments.cmd_recordings import (add_recording_options, conditioning
 from ddmm.experiments.io import ensure_out_dir, save_figure
 from ddmm.population.io.arrays import EXTENSIONS
 
-__all__ = ["check_out_file", "register", "register_demo", "scenes_from_args", "write_plots"]
+__all__ = ["ENGINE_HELP", "check_out_file", "register", "register_demo", "scenes_from_args", "write_plots"]
+
+ENGINE_HELP = ("brian2 (default: Brian2's C++ standalone device, compiled once per shape) or direct (the numba "
+               "integrator: the same spikes bit for bit, no C++ compile, usually faster)")
 
 SCENES = ("birznieks", "press-push-lift", "rotating-shear")
 
@@ -27,7 +30,7 @@ def _add_run_options(p, *, out_required: bool) -> None:
     p.add_argument("--theta-r", default=None, metavar="DEG[,DEG...]",
                    help="shear direction(s) in degrees, one condition each ('none': normal only); default 90")
     p.add_argument("--contact", default=None, metavar="X,Y,R", help="contact centre and radius in mm")
-    p.add_argument("--engine", choices=("brian2", "direct"), default="brian2")
+    p.add_argument("--engine", choices=("brian2", "direct"), default="brian2", help=ENGINE_HELP)
     p.add_argument("--dt", type=float, default=None, metavar="MS", help="integration step in ms (default 0.1)")
     p.add_argument("--method", choices=("euler", "rk2", "rk4", "izhikevich2003"), default=None,
                    help="integration scheme (default euler)")
@@ -173,8 +176,8 @@ def run_simulate(args) -> int:
     save_dataset(ds, out)
     if not args.quiet:
         choice = f"; {ds.attrs['tolerance_choice']}" if "tolerance_choice" in ds.attrs else ""
-        print(f"wrote {out} ({ds.sizes['afferent']} afferents, {ds.sizes['spike']} spikes, "
-              f"{time.perf_counter() - start:.2f} s{choice})")
+        print(f"wrote {out} ({ds.sizes['afferent']} afferents, {ds.sizes['spike']} spikes{choice}; "
+              f"wall time {time.perf_counter() - start:.1f} s)")
     return 0
 
 
@@ -231,7 +234,7 @@ def register_demo(sub) -> None:
     """Add ``ddmm demo``."""
     p = sub.add_parser("demo", help="the main job: fingertip population on press-push-lift, data and figures")
     p.add_argument("--out", default="ddmm-demo", metavar="DIR", help="output directory (default ./ddmm-demo)")
-    p.add_argument("--engine", choices=("brian2", "direct"), default="brian2")
+    p.add_argument("--engine", choices=("brian2", "direct"), default="brian2", help=ENGINE_HELP)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=run_demo)

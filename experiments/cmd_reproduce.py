@@ -6,6 +6,7 @@ import json
 import sys
 import warnings
 
+from ddmm.experiments.cmd_population import ENGINE_HELP
 from ddmm.experiments.cmd_recordings import add_recording_options
 from ddmm.experiments.io import ensure_out_dir, save_figure, save_json
 
@@ -23,7 +24,7 @@ def register(sub) -> None:
     p.add_argument("--calibration", choices=tuple(CALIBRATIONS), default="paper",
                    help="paper (default): the unpublished constants fitted type by type to Table III; "
                         "gains-only: only the gains, fitted to the CMM column (eq. 17 reading, contact-mean SF)")
-    p.add_argument("--engine", choices=("brian2", "direct"), default="brian2")
+    p.add_argument("--engine", choices=("brian2", "direct"), default="brian2", help=ENGINE_HELP)
     p.add_argument("--no-shear", choices=("pass", "block"), default=None,
                    help="override every type's reading of eq. 17 below F_TH: pass (AF=1) or block (AF=0)")
     p.add_argument("--scene", metavar="FILE.csv", help="table4: the press-push-lift recording (e.g. the authors')")
@@ -93,7 +94,8 @@ def _write_figures(out_dir, what, calibration, result) -> list[str]:
         for kind, config in calibration.items():
             for profile in PROFILES:
                 data = response_data(scene_of(config), profile, angles, config, types=(kind,))
-                fig = plot_response(data, title=f"{name}: {kind}, {profile} (no_shear={config.no_shear})")
+                bin_s = config.bin_s if config.sf_definition == "peak_bin" else None  # the bins SF counts in
+                fig = plot_response(data, title=f"{name}: {kind}, {profile} (no_shear={config.no_shear})", bin_s=bin_s)
                 written.append(str(save_figure(fig, out_dir / f"{name}_{kind}_{profile}.png")))
     return written
 

@@ -82,19 +82,24 @@ def plot_hand(population, counts=None, ax=None) -> Figure:
     _draw_outlines(ax)
     active = np.ones(types.shape, bool) if counts is None else counts > 0
     if counts is not None:
-        ax.scatter(x[~active], y[~active], s=0.5, color="0.75", label="silent")
+        ax.scatter(x[~active], y[~active], s=0.5, color="0.75", label=f"silent ({int((~active).sum())})")
         size = 1.0 + 40.0 * counts / max(counts.max(), 1e-12)
     for kind in AFFERENT_TYPES:
         sel = (types == kind) & active
-        if np.any(sel):
+        silent = int(np.sum((types == kind) & ~active))
+        if np.any(types == kind):  # the count is every afferent of the type, the silent ones named
             ax.scatter(x[sel], y[sel], s=1.5 if counts is None else size[sel], color=_TYPE_COLOURS[kind],
-                       alpha=0.6, lw=0, label=f"{type_label(kind)} ({int(sel.sum())})")
+                       alpha=0.6, lw=0, label=f"{type_label(kind)} ({int(np.sum(types == kind))}"
+                                              + (f", {silent} silent)" if silent else ")"))
     ax.set_xlim(*_limits(x, y, region)[0])
     ax.set_ylim(*_limits(x, y, region)[1])
     ax.set_aspect("equal")
     ax.set_xlabel("x (mm, radial +)")
     ax.set_ylabel("y (mm, distal +)")
     what = "afferents by type" if counts is None else "spike count (marker area)"
-    ax.set_title(f"hand map, palmar view of a right hand: {what}", fontsize=9)
+    shown = [n for n in hand_map.REGIONS if np.any(region == n)]
+    where = "right hand" if not shown or len(shown) == len(hand_map.REGIONS) else \
+        f"region{'s' if len(shown) > 1 else ''} {', '.join(shown)} of a right hand"
+    ax.set_title(f"{where}, palmar view: {what}", fontsize=9)
     ax.legend(fontsize=7, markerscale=3, loc="lower left")
     return ax.figure

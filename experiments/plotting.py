@@ -26,7 +26,7 @@ def _plot_forces(ax, time, forces):
     for name, colour in (("fx", "tab:red"), ("fy", "tab:green"), ("fz", "k")):
         ax.plot(time, forces[name], color=colour, lw=1.2, label=name.upper().replace("F", "F_"))
     ax.set_ylabel("force (N)")
-    ax.legend(loc="upper right", fontsize=7, ncol=3)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7, frameon=False)  # outside: never on a trace
 
 
 def _plot_spikes(ax, spike_times, duration, bin_s, colour, label):
@@ -217,16 +217,17 @@ def plot_dsi_histograms(tuning, reference: dict | None = None) -> Figure:
 
 def plot_preferred_rose(tuning, bins: int = 16) -> Figure:
     """Rose plot of preferred directions of tuned afferents, per type (0 radial, 90 distal)."""
-    fig = Figure(figsize=(4.0 * len(AFFERENT_TYPES), 4.0), layout="constrained")
+    fig = Figure(figsize=(4.2 * len(AFFERENT_TYPES), 5.0), layout="constrained")
     edges = np.linspace(0, 2 * np.pi, bins + 1)
     for i, kind in enumerate(AFFERENT_TYPES):
         ax = fig.add_subplot(1, len(AFFERENT_TYPES), i + 1, projection="polar")
         sel = (tuning.afferent_type.values == kind) & (tuning.tuned.values == 1) & (tuning.has_preferred.values == 1)
         counts, _ = np.histogram(np.deg2rad(tuning.preferred_deg.values[sel]), edges)
         ax.bar(edges[:-1], counts, width=edges[1] - edges[0], align="edge", color=_TYPE_COLOURS[kind], alpha=0.7)
-        ax.set_xticks(np.deg2rad([0, 90, 180, 270]), ["radial", "distal", "ulnar", "proximal"])
-        ax.set_title(f"{type_label(kind)}: preferred directions of {int(sel.sum())} tuned\n(vector sum; axial ones omitted)",
-                     fontsize=9, pad=14)
+        ax.set_xticks(np.deg2rad([0, 90, 180, 270]), ["radial", "distal", "ulnar", "proximal"], fontsize=8)
+        ax.tick_params(axis="x", pad=2)
+        ax.set_title(f"{type_label(kind)}: preferred directions of {int(sel.sum())} tuned\n(vector sum; axial ones "
+                     "omitted)", fontsize=9, pad=22)
     return fig
 
 

@@ -11,9 +11,11 @@ spike.
 
 from __future__ import annotations
 
+import os
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -348,7 +350,9 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
         pool of worker processes, a Dask client, or a scheduler address
         (`ddmm.population.runtime.distributed`).  The Dataset is bit-identical either way.
     quiet : bool
-        Hide the progress bar (shown on stderr for runs over about a second).
+        Hide the progress bar.  Otherwise it is shown on stderr for runs over
+        about a second when stderr is a terminal (tqdm's convention);
+        ``DDMM_PROGRESS=0`` hides it and ``DDMM_PROGRESS=1`` shows it always.
 
     Returns
     -------
@@ -378,14 +382,43 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
     spikes = [[] for _ in scenes]
     members = [_unit_members(cond) for cond in the_plan.conditions]
     work = list(_jobs(population, scenes, the_plan))
+    _compile_notice(quiet)
     with tqdm(total=the_plan.work(), unit="aff-sample", unit_scale=True, delay=1.0, file=sys.stderr,
-              disable=quiet, leave=False) as bar:
+              disable=_progress_disabled(quiet), leave=False) as bar:
         results = _run_jobs([job for _, job, _, _ in work], config, scheduler, bar.update)
     for (c, _, block, det), result in zip(work, results):
         spikes[c].append(_expand(the_plan.conditions[c], members[c], the_plan, block, det, result))
     ds = build_dataset(population, scenes, the_plan, spikes, config)
     ds.attrs.update(choice)
     return ds
+
+
+def _progress_disabled(quiet: bool):
+    """tqdm's ``disable`` for a run: True when ``quiet``; ``DDMM_PROGRESS`` 0 / 1 forces off / on; else None
+    (tqdm then shows the bar only when stderr is a terminal)."""
+    setting = os.environ.get("DDMM_PROGRESS", "").strip()
+    if setting not in ("", "0", "1"):
+        raise ValueError(f"the environment variable DDMM_PROGRESS must be 0 or 1, got {setting!r}")
+    if quiet or setting == "0":
+        return True
+    return False if setting == "1" else None
+
+
+_NOTICED: list = []  # the compile notice is printed once per process
+
+
+def _compile_notice(quiet: bool) -> None:
+    """One line on stderr before numba compiles the kernels into an empty cache (the first run, ~20 s)."""
+    if quiet or _NOTICED:
+        return
+    _NOTICED.append(True)
+    import ddmm.models.fused as fused
+
+    where = os.environ.get("NUMBA_CACHE_DIR")
+    cache = Path(where) if where else Path(fused.__file__).parent / "__pycache__"
+    if not any(cache.rglob("fused.*.nbi")):
+        print(f"ddmm: compiling the numba kernels (first run only, about 20 s; cached in {cache})",
+              file=sys.stderr, flush=True)
 
 
 def _run_jobs(jobs, config, scheduler, progress) -> list:

@@ -26,6 +26,13 @@ def test_tuning_json_and_figures(capsys, tmp_path):
     assert {"tuning.json", "dsi_histograms.png", "preferred_directions.png"} <= {p.name for p in tmp_path.iterdir()}
 
 
+def test_tuning_prints_its_table(capsys):
+    """The text path (a strict type label once broke it on the pooled rows)."""
+    code, out, err = run(capsys, "tuning", "--population", "fingertip", "--seed", "2", "--trials", "3")
+    assert code == 0, err
+    assert "| SA-I + SA-II + FA-I | " in out and "| all four types | " in out and "| FA-II | " in out
+
+
 def test_decode_json_shape(capsys, tmp_path):
     code, out, _ = run(capsys, "decode", "--seed", "1", "--train", "40", "--test", "20", "--subsets", "1",
                        "--json", "--out", tmp_path)

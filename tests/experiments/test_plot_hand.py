@@ -36,6 +36,17 @@ def test_counts_set_marker_sizes_and_silent_afferents_are_grey(hand):
     sizes = np.concatenate([c.get_sizes() for c in active])
     assert sizes.size == 10 and sizes.max() == pytest.approx(41.0)
     assert ax.get_ylim()[1] < 20.0  # zoomed on the regions present
+    # the legend counts every afferent of a type and names the silent ones; the title names the regions shown
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels[0] == f"silent ({len(pop) - 10})"
+    types = pop.afferent_type
+    for kind, label in zip([k for k in ("SAI", "RAI", "RAII", "SAII") if np.any(types == k)], labels[1:]):
+        n = int(np.sum(types == kind))
+        quiet = n - int(np.sum(types[:10] == kind))
+        assert label == f"{type_label(kind)} ({n}" + (f", {quiet} silent)" if quiet else ")")
+    assert ax.get_title() == "regions D2m, D2d of a right hand, palmar view: spike count (marker area)" \
+        or ax.get_title() == "regions D2d, D2m of a right hand, palmar view: spike count (marker area)"
+    assert plot_hand(hand).axes[0].get_title() == "right hand, palmar view: afferents by type"
 
 
 def test_draws_into_a_given_axes_and_takes_a_dataset():

@@ -217,7 +217,8 @@ def _build(key: tuple) -> _Build:
     if not compiled:
         print(
             f"ddmm: compiling the Brian2 engine for {n_neurons} neurons x {n_samples} samples "
-            f"(dt={dt * 1e3:g} ms, {method}); once per shape, cached in {directory}",
+            f"(dt={dt * 1e3:g} ms, {method}); once per shape, cached in {directory} (--engine direct gives the "
+            f"same spikes with no compile)",
             file=sys.stderr,
             flush=True,
         )
