@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import difflib
+import os
 import re
 import sys
 
@@ -61,6 +62,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Population-coding simulator of tactile afferents (DDMM).",
     )
     parser.add_argument("--version", action="version", version=f"ddmm {__version__}")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the full traceback of an unexpected error (also DDMM_DEBUG=1)")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                 parser_class=_Parser)
     for module in (cmd_reproduce, cmd_population, cmd_biology, cmd_physiology, cmd_accuracy, cmd_stream, cmd_export,
@@ -71,20 +74,32 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     """Entry point of the ``ddmm`` console script."""
-    from ddmm.population._extras import MissingExtraError
-
     args = build_parser().parse_args(argv)
+    debug = args.debug or os.environ.get("DDMM_DEBUG", "") not in ("", "0")
     try:
         return int(args.func(args) or 0)
-    except (ValueError, TypeError, MissingExtraError) as exc:  # a missing extra says which to install
-        print(f"ddmm: error: {exc}", file=sys.stderr)
-        return 2
-    except OSError as exc:
-        print(f"ddmm: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "), file=sys.stderr)
-        return 2
     except KeyboardInterrupt:
         print("ddmm: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:  # noqa: BLE001 - the CLI never shows a traceback unless asked
+        if debug:
+            raise
+        print(f"ddmm: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+
+
+def _one_line(exc: BaseException) -> str:
+    """The message of an error, on one line; an unexpected kind says so and how to see the traceback."""
+    from ddmm.population._extras import MissingExtraError
+
+    if isinstance(exc, (ValueError, TypeError, MissingExtraError)):  # a missing extra says which to install
+        text = str(exc)
+    elif isinstance(exc, OSError):
+        text = f"{exc.strerror or exc}: {exc.filename or ''}".rstrip(": ")
+    else:
+        text = (f"unexpected {type(exc).__name__}: {exc} (a bug or a broken environment; rerun as "
+                f"'ddmm --debug ...' for the traceback)")
+    return " ".join(text.split())
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -7,7 +7,7 @@ from pathlib import Path
 
 TUNING_TRIALS = 5  # ddmm.population.analysis.tuning.DEFAULT_TRIALS, repeated so that registering the parser imports nothing heavy
 
-from ddmm.experiments.io import atomic_write, ensure_out_dir, save_figure, save_json
+from ddmm.experiments.io import atomic_write, ensure_out_dir, save_figure, save_json, seed_arg
 from ddmm.experiments.paper_values import HUMAN_DIRECTION_THRESHOLD_DEG, HUMAN_DSI, HUMAN_TUNED_FRACTION
 from ddmm.models.afferent_types import type_label
 
@@ -30,7 +30,7 @@ def register(sub) -> None:
     """Add the tuning, calibrate and decode subcommands."""
     p = sub.add_parser("tuning", help="direction-tuning statistics against human recordings (~86%% tuned)")
     p.add_argument("--population", default="fingertip")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_arg, default=0)
     p.add_argument("--trials", type=int, default=TUNING_TRIALS, help=f"per condition (default {TUNING_TRIALS})")
     p.add_argument("--engine", choices=("brian2", "direct"), default="direct")
     p.add_argument("--correction", choices=("none", "bonferroni"), default="none")
@@ -42,7 +42,7 @@ def register(sub) -> None:
     p.add_argument("--target", choices=("presets", "paper"), default="presets",
                    help="presets (default): the physiological presets; paper: the paper's unpublished constants, "
                         "type by type (docs/model.md, 'The paper calibration')")
-    p.add_argument("--seed", type=int, default=0, help="--target paper: the random search's seed")
+    p.add_argument("--seed", type=seed_arg, default=0, help="--target paper: the random search's seed")
     p.add_argument("--out", metavar="DIR", help="write calibrate.json and calibrated_{fingertip,hand}.toml "
                                                 "(--target paper: paper_calibration.json) here")
     p.add_argument("--json", action="store_true")
@@ -52,7 +52,7 @@ def register(sub) -> None:
                    help="direction (default), torque (torsion scenes) or slip (incipient-slip scenes)")
     p.add_argument("--trials", type=int, default=20, help="torque and slip: trials per condition, half for training")
     p.add_argument("--population", default="fingertip")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_arg, default=0)
     p.add_argument("--train", type=int, default=200, help="training trials (directions)")
     p.add_argument("--test", type=int, default=200, help="test trials (directions)")
     p.add_argument("--subsets", type=int, default=10, help="random subsets per population size")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import math
 
-from ddmm.experiments.io import ensure_out_dir, save_figure, save_json
+from ddmm.experiments.io import ensure_out_dir, save_figure, save_json, seed_arg
 from ddmm.experiments.paper_values import HUMAN_DSI
 from ddmm.models.afferent_types import type_label
 
@@ -16,7 +16,7 @@ def register(sub) -> None:
     """Add ``ddmm physiology``."""
     p = sub.add_parser("physiology", help="scorecard of the population against human afferent physiology")
     p.add_argument("--population", default="fingertip", help="fingertip, hand or a spec .toml file")
-    p.add_argument("--seed", type=int, default=0, help="population and noise seed (default 0)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="population and noise seed (default 0)")
     p.add_argument("--properties", default=None, metavar="NAME[,NAME...]",
                    help="comma-separated property names (default: all; docs/validation.md lists them)")
     p.add_argument("--engine", choices=("brian2", "direct"), default="direct")

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import math
 import time
 import warnings
 from pathlib import Path
 
 from ddmm.experiments.cmd_recordings import (add_recording_options, conditioning_from_args, csv_scene,
                                             refuse_csv_options)
-from ddmm.experiments.io import ensure_out_dir, save_figure
+from ddmm.experiments.io import ensure_out_dir, save_figure, seed_arg
 from ddmm.population.io.arrays import EXTENSIONS
 
 __all__ = ["ENGINE_HELP", "check_out_file", "register", "register_demo", "scenes_from_args", "write_plots"]
@@ -37,7 +38,7 @@ def _add_run_options(p, *, out_required: bool) -> None:
     p.add_argument("--tolerance", type=float, default=None, metavar="PPS",
                    help="choose the cheapest dt and method whose mean SF error is within PPS pulses/s")
     p.add_argument("--trials", type=int, default=1)
-    p.add_argument("--seed", type=int, default=0, help="seed of the population and the noise (default 0)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="seed of the population and the noise (default 0)")
     p.add_argument("--no-shear", choices=("smooth", "pass", "block"), default="smooth",
                    help="reading of eq. 17: the continuous transition (default) or the paper's two")
     p.add_argument("--types", default=None, metavar="T[,T...]", help="afferent types to simulate")
@@ -75,9 +76,12 @@ def _directions(text, default="90"):
             out.append(None)
             continue
         try:
-            out.append(float(part))
+            value = float(part)
         except ValueError:
-            raise ValueError(f"--theta-r: {part!r} is not a number of degrees or 'none'") from None
+            value = float("nan")
+        if not math.isfinite(value):
+            raise ValueError(f"--theta-r: {part!r} is not a finite number of degrees or 'none'")
+        out.append(value)
     return out
 
 
@@ -235,7 +239,7 @@ def register_demo(sub) -> None:
     p = sub.add_parser("demo", help="the main job: fingertip population on press-push-lift, data and figures")
     p.add_argument("--out", default="ddmm-demo", metavar="DIR", help="output directory (default ./ddmm-demo)")
     p.add_argument("--engine", choices=("brian2", "direct"), default="brian2", help=ENGINE_HELP)
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_arg, default=0)
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=run_demo)
 

@@ -21,6 +21,7 @@ import sys
 import numpy as np
 
 from ddmm.experiments.cmd_recordings import add_recording_options, conditioning_from_args
+from ddmm.experiments.io import seed_arg
 
 __all__ = ["register", "stream"]
 
@@ -31,7 +32,7 @@ def register(sub) -> None:
     p.add_argument("--population", default="fingertip")
     p.add_argument("--fs", type=float, required=True, help="sample rate of the input in Hz")
     p.add_argument("--dt", type=float, default=0.1, metavar="MS")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed_arg, default=0)
     p.add_argument("--engine", choices=("direct", "brian2"), default="direct")
     p.add_argument("--types", default=None, metavar="T[,T...]",
                    help="afferent types to simulate (leave FA-II out below 750 Hz)")

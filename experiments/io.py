@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 from pathlib import Path
 
 from ddmm.population.io._files import atomic_write
 
-__all__ = ["ensure_out_dir", "atomic_write", "save_figure", "save_json"]
+__all__ = ["ensure_out_dir", "atomic_write", "save_figure", "save_json", "seed_arg"]
 
 
 def ensure_out_dir(path) -> Path:
@@ -41,3 +42,14 @@ def save_json(obj, path) -> Path:
             json.dump(obj, fh, indent=2)
             fh.write("\n")
     return atomic_write(path, write)
+
+
+def seed_arg(text: str) -> int:
+    """The argparse type of ``--seed``: an integer >= 0 (what numpy takes as a seed)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0 (a numpy seed), got {value}")
+    return value

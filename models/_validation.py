@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numbers
 
+import re
+
 import numpy as np
 
-__all__ = ["as_finite_array", "check_positive", "check_choice", "check_forces"]
+__all__ = ["as_finite_array", "check_positive", "check_choice", "check_forces", "parse_number"]
 
 
 def as_finite_array(value, name: str, ndim: int | None = None) -> np.ndarray:
@@ -28,7 +30,7 @@ def as_finite_array(value, name: str, ndim: int | None = None) -> np.ndarray:
     if not np.all(np.isfinite(arr)):
         bad = int(np.flatnonzero(~np.isfinite(arr.ravel()))[0])
         raise ValueError(
-            f"{name} must be finite; got {arr.ravel()[bad]!r} at flat index {bad}"
+            f"{name} must be finite; got {float(arr.ravel()[bad])} at flat index {bad}"
         )
     return arr
 
@@ -70,3 +72,24 @@ def check_forces(fx, fy, fz) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             f"fz must be >= 0 N (compressive normal force); got {fz[bad]!r} at index {bad}"
         )
     return fx, fy, fz
+
+
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(inf|infinity|nan)", re.IGNORECASE)
+
+
+def parse_number(text: str) -> float:
+    """A decimal number written in a text file: ``float`` without its Python-only forms.
+
+    ``float`` also takes ``"1_0"`` (10.0) and surrounding whitespace of any
+    kind; a data file means neither.  Raises ValueError; ``inf`` and ``nan``
+    parse (callers check finiteness with their own message).
+
+    Examples
+    --------
+    >>> parse_number(" 1.5e-3 "), parse_number("-2")
+    (0.0015, -2.0)
+    """
+    stripped = text.strip(" \t")
+    if not _NUMBER.fullmatch(stripped):
+        raise ValueError(f"{text!r} is not a number")
+    return float(stripped)

@@ -270,7 +270,17 @@ def load_dataset(path) -> xr.Dataset:
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"dataset file {str(path)!r} does not exist")
-    return xr.load_dataset(path, engine="h5netcdf")
+    try:
+        ds = xr.load_dataset(path, engine="h5netcdf")
+    except (OSError, ValueError) as exc:
+        reason = " ".join(str(exc).split())
+        raise ValueError(f"dataset file {str(path)!r} is not a netCDF-4 file ddmm can read ({reason})") from None
+    if "afferent" not in ds.dims or "ddmm_version" not in ds.attrs:
+        array = ds.attrs.get("layout") == "ddmm sensor array"
+        raise ValueError(f"dataset file {str(path)!r} is not a ddmm simulation dataset (no afferent dimension"
+                         + ("; it is a sensor-array file: simulate it with 'ddmm simulate --scene FILE')"
+                            if array else ")"))
+    return ds
 
 
 def binned_counts(ds: xr.Dataset, bin_s: float, *, t_max: float | None = None) -> xr.DataArray:

@@ -514,14 +514,18 @@ def load_spec(source) -> PopulationSpec:
     if path.suffix != ".toml":
         raise ValueError(f"population={str(source)!r}: give a preset ({', '.join(PRESETS)}) or a .toml file")
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ValueError(f"population file {str(path)!r} cannot be read: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"population file {str(path)!r} is not UTF-8 text (byte {exc.start}); TOML is UTF-8") from None
     name = path.stem
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"population file {name!r} is not valid TOML: {exc}") from None
+        raise ValueError(f"population file {str(path)!r} is not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ValueError(f"population file {str(path)!r} nests arrays or tables too deeply to be a spec") from None
     return spec_from_dict(data, default_name=name)
 
 

@@ -52,6 +52,11 @@ def check_dataset(dataset, caller: str) -> None:
     if any(name not in dataset.variables for name in _EVENTS):
         raise ValueError(f"{caller}: dataset has no spike events (spike_time etc.); simulate with record "
                          "including 'spikes'")
+    times = np.asarray(dataset["spike_time"].values, dtype=float)
+    if times.size and not (np.all(np.isfinite(times)) and times.min() >= 0):
+        bad = int(np.flatnonzero(~np.isfinite(times) | (times < 0))[0])
+        raise ValueError(f"{caller}: dataset spike_time must be finite and >= 0 s, got {float(times[bad])} at event "
+                         f"{bad}; was the Dataset edited after simulation?")
     for name, dim in (("spike_afferent", "afferent"), ("spike_trial", "trial"), ("spike_condition", "condition")):
         pos = dataset[name].values
         if pos.size and not (0 <= pos.min() and pos.max() < dataset.sizes[dim]):

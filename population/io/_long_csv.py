@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ddmm.models._validation import parse_number
+
 __all__ = ["TIME_TOL", "read_sites_csv", "read_long_forces", "uniform_grid"]
 
 #: Relative tolerance on time stamps: each lies within this fraction of a step of the uniform grid.
@@ -19,11 +21,13 @@ def _csv_rows(path, what: str, required: tuple, optional: tuple = ()):
 
     where = f"{what} file {str(path)!r}"
     try:
-        with open(path, newline="") as fh:
+        with open(path, newline="", encoding="utf-8") as fh:
             reader = csv.reader(fh)
             rows = [(reader.line_num, row) for row in reader if row and any(cell.strip() for cell in row)]
     except OSError as exc:
         raise ValueError(f"{where} cannot be read: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{where} is not UTF-8 text (byte {exc.start})") from None
     if not rows:
         raise ValueError(f"{where} is empty")
     header = [h.strip() for h in rows[0][1]]
@@ -41,7 +45,7 @@ def _csv_rows(path, what: str, required: tuple, optional: tuple = ()):
 
 def _cell_float(where: str, col: str, line: int, text: str) -> float:
     try:
-        value = float(text)
+        value = parse_number(text)
     except ValueError:
         raise ValueError(f"{where}: column {col!r}, line {line}: {text!r} is not a number") from None
     if not np.isfinite(value):

@@ -265,6 +265,9 @@ def _read_hdf5(path, where: str) -> dict:
             if unknown:
                 raise ValueError(f"{where}: unknown dataset {unknown[0]!r}; "
                                  f"allowed: {', '.join(_REQUIRED + _OPTIONAL)}")
+            for k in fh.keys():  # only the file's own data: a link could read any file the user can
+                if not isinstance(fh.get(k, getlink=True), h5py.HardLink) or not isinstance(fh[k], h5py.Dataset):
+                    raise ValueError(f"{where}: {k!r} must be a dataset stored in the file, not a link or a group")
             fields = {k: fh[k][()] for k in fh.keys()}
             if "fs" not in fields and "fs" in fh.attrs:
                 fields["fs"] = fh.attrs["fs"]

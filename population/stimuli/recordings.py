@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.models._validation import check_positive
+from ddmm.models._validation import check_positive, parse_number
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Contact, Scene
 
@@ -47,10 +47,12 @@ class RecordingBandWarning(UserWarning):
 def _read(path, wanted: dict) -> tuple:
     """(the mapped columns as float arrays, the file's header): header names matched case-insensitively."""
     try:
-        with open(path, newline="") as fh:
+        with open(path, newline="", encoding="utf-8") as fh:
             rows = [row for row in csv.reader(fh) if row and any(cell.strip() for cell in row)]
     except OSError as exc:
         raise ValueError(f"scene file {str(path)!r} cannot be read: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"scene file {str(path)!r} is not UTF-8 text (byte {exc.start})") from None
     if not rows:
         raise ValueError(f"scene file {str(path)!r} is empty")
     header = [h.strip() for h in rows[0]]
@@ -70,7 +72,7 @@ def _read(path, wanted: dict) -> tuple:
                              f"{len(header)}")
         for ours, i in index.items():
             try:
-                out[ours][r - 2] = float(row[i])
+                out[ours][r - 2] = parse_number(row[i])
             except ValueError:
                 raise ValueError(f"scene file {str(path)!r}: column {header[i]!r}, line {r}: {row[i]!r} is not a "
                                  "number") from None

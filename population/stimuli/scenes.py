@@ -27,6 +27,11 @@ __all__ = [
 
 #: Default force sample rate in Hz: 50x the 20 Hz derivative cut-off.
 DEFAULT_FS = 1000.0
+#: Bounds of physical sense, checked by the constructors: sample rate (Hz), footprint radius (mm: larger than a
+#: hand), and the inclination of Birznieks' force from the normal (deg: tan 80 = 5.7 times the normal force).
+MAX_FS = 1.0e6
+MAX_RADIUS_MM = 200.0
+MAX_INCLINATION_DEG = 80.0
 
 
 @dataclass(frozen=True)
@@ -43,6 +48,9 @@ class Contact:
             if not np.isfinite(value):
                 raise ValueError(f"contact {name} must be finite, got {value!r}")
         check_positive(self.radius_mm, "contact radius_mm", "mm")
+        if self.radius_mm > MAX_RADIUS_MM:
+            raise ValueError(f"contact radius_mm must be <= {MAX_RADIUS_MM:g} mm (a contact larger than a hand), "
+                             f"got {float(self.radius_mm):g}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,9 +85,9 @@ class Sites:
         r = np.broadcast_to(as_finite_array(self.radius_mm, "sites radius_mm"), (n,)).copy()
         if y.size != n:
             raise ValueError(f"sites: x_mm and y_mm must have equal length; got {n} and {y.size}")
-        if np.any(r <= 0):
-            i = int(np.flatnonzero(r <= 0)[0])
-            raise ValueError(f"sites radius_mm must be > 0 mm; got {r[i]!r} at site {i}")
+        if np.any((r <= 0) | (r > MAX_RADIUS_MM)):
+            i = int(np.flatnonzero((r <= 0) | (r > MAX_RADIUS_MM))[0])
+            raise ValueError(f"sites radius_mm must be in (0, {MAX_RADIUS_MM:g}] mm; got {float(r[i]):g} at site {i}")
         region = np.full(n, "", dtype=object) if self.region is None else np.asarray(self.region, dtype=object)
         ids = np.array([str(i) for i in range(n)], dtype=object) if self.site_id is None else np.asarray(
             [str(s) for s in self.site_id], dtype=object)
@@ -115,11 +123,23 @@ def taxel_radius(pitch_mm: float) -> float:
 
 @dataclass(frozen=True)
 class Stage:
-    """A labelled interval [start, end) of a scene, in seconds."""
+    """A labelled interval [start, end) of a scene, in seconds (0 <= start <= end)."""
 
     label: str
     start: float
     end: float
+
+    def __post_init__(self):
+        if not isinstance(self.label, str):
+            raise TypeError(f"stage label must be a str, got {type(self.label).__name__}")
+        for name in ("start", "end"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
+                    or not np.isfinite(value):
+                raise ValueError(f"stage {self.label!r}: {name} must be a finite number of seconds, got {value!r}")
+        if not 0.0 <= self.start <= self.end:  # an empty stage (a zero-length ramp) is allowed
+            raise ValueError(f"stage {self.label!r} must start at or after 0 s and end no earlier, got "
+                             f"{float(self.start):g}-{float(self.end):g} s")
 
 
 @dataclass(frozen=True, eq=False)
@@ -173,13 +193,27 @@ class Scene:
             i = int(np.flatnonzero(arrays[2] < 0)[0])
             raise ValueError(f"fz must be >= 0 N (compressive); got {arrays[2][i]!r} at t = {i / self.fs} s")
         check_positive(self.fs, "fs", "Hz")
+        if self.fs > MAX_FS:
+            raise ValueError(f"fs must be <= {MAX_FS:g} Hz (no force sensor samples faster), got {float(self.fs):g}")
         if self.contact is not None and not isinstance(self.contact, Contact):
             raise TypeError(f"contact must be a Contact or None, got {type(self.contact).__name__}")
         for n, a in zip(("fx", "fy", "fz"), arrays):
             a.setflags(write=False)
             object.__setattr__(self, n, a)
         object.__setattr__(self, "stages", tuple(self.stages))
+        self._check_stages(arrays[0].size / float(self.fs))
         self._check_sites(arrays[0].size)
+
+    def _check_stages(self, duration: float) -> None:
+        for stage in self.stages:
+            if not isinstance(stage, Stage):
+                raise TypeError(f"stages must be Stage objects, got {type(stage).__name__} ({stage!r})")
+            if stage.start >= duration:
+                raise ValueError(f"stage {stage.label!r} starts at {float(stage.start):g} s, after the scene's "
+                                 f"end at {duration:g} s")
+        if self.theta_r is not None and not (isinstance(self.theta_r, (int, float, np.floating, np.integer))
+                                             and np.isfinite(self.theta_r)):
+            raise ValueError(f"theta_r must be a finite angle in degrees or None, got {self.theta_r!r}")
 
     def _check_sites(self, n_samples: int) -> None:
         if (self.sites is None) != (self.site_forces is None):
@@ -294,6 +328,8 @@ def birznieks(direction_deg: float | None = 90.0, *, normal_n: float = 4.0, angl
     (1.456, 0.5)
     """
     _check_delay(shear_delay_s, ramp_s)
+    if not (isinstance(angle_deg, (int, float)) and 0.0 <= angle_deg <= MAX_INCLINATION_DEG):
+        raise ValueError(f"angle_deg must be in [0, {MAX_INCLINATION_DEG:g}] degrees from the normal, got {angle_deg!r}")
     t = _samples(2 * ramp_s + hold_s, fs)
     knots = [0.0, ramp_s, ramp_s + hold_s, 2 * ramp_s + hold_s]
     profile = np.interp(t, knots, [0.0, 1.0, 1.0, 0.0])

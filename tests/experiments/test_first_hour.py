@@ -81,3 +81,31 @@ def test_forces_legend_never_covers_a_trace():
     ax = fig.axes[0]
     legend, frame = ax.get_legend().get_window_extent(), ax.get_window_extent()
     assert legend.x0 >= frame.x1 - 1  # outside the axes, to the right
+
+
+def test_an_unexpected_error_is_one_line_and_debug_shows_it(capsys, monkeypatch):
+    from ddmm.experiments import cmd_population
+
+    def broken(args):
+        raise KeyError("afferent")
+
+    monkeypatch.setattr(cmd_population, "run_plan", broken)
+    monkeypatch.delenv("DDMM_DEBUG", raising=False)
+    code = main(["plan", "--scene", "birznieks"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "unexpected KeyError: 'afferent'" in err and "--debug" in err
+    with pytest.raises(KeyError):
+        main(["--debug", "plan", "--scene", "birznieks"])
+
+
+@pytest.mark.parametrize("argv,match", [
+    (["simulate", "--seed", "-1", "--out", "x.nc"], "argument --seed: must be an integer >= 0 (a numpy seed), got -1"),
+    (["plan", "--theta-r", "inf"], "--theta-r: 'inf' is not a finite number of degrees or 'none'"),
+])
+def test_options_are_named_with_plain_numbers(capsys, argv, match):
+    try:
+        code = main(argv)
+    except SystemExit as exc:
+        code = exc.code
+    err = capsys.readouterr().err
+    assert code == 2 and match in err and "np.float64" not in err and err.count("\n") == 1, err

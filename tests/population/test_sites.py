@@ -120,7 +120,7 @@ def test_dataset_records_sites(pop):
 def test_bad_sites(pop):
     with pytest.raises(ValueError, match="duplicate site id 'a'"):
         Sites([0.0, 1.0], [0.0, 0.0], 1.0, site_id=["a", "a"])
-    with pytest.raises(ValueError, match="radius_mm must be > 0"):
+    with pytest.raises(ValueError, match=r"radius_mm must be in \(0, 200\] mm"):
         Sites([0.0], [0.0], 0.0)
     with pytest.raises(ValueError, match=r"site_forces must have shape \(n_samples, n_sites, 3\) = \(4, 2, 3\)"):
         Scene(np.zeros(4), np.zeros(4), np.ones(4), sites=Sites([0.0, 1.0], [0.0, 0.0], 1.0),
