@@ -1,6 +1,7 @@
 """Lanes of the Brian2 engine: each concurrent run's own input files and results directory.
 
-A lane is a directory ``$DDMM_CACHE_DIR/brian2/lanes/<pid>_<k>`` holding the
+A lane is a private directory ``$DDMM_CACHE_DIR/brian2/lanes/<pid>_<k>_<random>``
+(``mkdtemp``: mode 0700, an unpredictable name, no symlink followed) holding the
 current table, the per-neuron inputs and the binary's ``results/``.  A lane
 serves one run at a time and keeps its files between runs, rewritten in
 place (the table through a memory map, `write_table`): writing a fresh
@@ -17,13 +18,14 @@ import atexit
 import os
 import queue
 import shutil
+import tempfile
 import threading
 from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
-from ddmm.models._cache import cache_root
+from ddmm.models._cache import cache_root, private_dir
 
 __all__ = ["lane", "write_table"]
 
@@ -75,9 +77,11 @@ def _new() -> Path:
             _MINE.clear()
             _sweep()
             atexit.register(_remove, pid)
-        path = _root() / f"{pid}_{len(_MINE)}"
+        root = private_dir(_root())
+        # mkdtemp: an unpredictable name, mode 0700, created (never an existing path or a symlink followed)
+        path = Path(tempfile.mkdtemp(prefix=f"{pid}_{len(_MINE)}_", dir=root))
         _MINE.append(path)
-    (path / "results").mkdir(parents=True, exist_ok=True)
+    (path / "results").mkdir()
     return path
 
 

@@ -1,0 +1,69 @@
+"""The Brian2 build cache under faults: concurrent first builds, a damaged binary, an unsafe directory."""
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from ddmm.models import integrate
+from ddmm.models._cache import private_dir
+from ddmm.models.engines.brian2 import engine
+
+_RUN = """
+import numpy as np
+from ddmm.models import integrate
+current = np.tile(np.linspace(0.0, 30.0, 7), (300, 1))
+r = integrate(current, fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")
+print(r.step.tolist(), r.afferent.tolist())
+"""
+
+
+def _current():
+    return np.tile(np.linspace(0.0, 30.0, 7), (300, 1))
+
+
+def test_two_processes_building_into_one_empty_cache_both_succeed(tmp_path):
+    cache = tmp_path / "cache"
+    env = dict(os.environ, DDMM_CACHE_DIR=str(cache))
+    procs = [subprocess.Popen([sys.executable, "-c", _RUN], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True) for _ in range(2)]
+    outs = [p.communicate(timeout=600) for p in procs]
+    assert [p.returncode for p in procs] == [0, 0], [err[-2000:] for _, err in outs]
+    assert outs[0][0] == outs[1][0] and outs[0][0].strip()
+    direct = integrate(_current(), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="direct")
+    assert outs[0][0].strip() == f"{direct.step.tolist()} {direct.afferent.tolist()}"
+    builds = [p for p in (cache / "brian2").iterdir() if p.is_dir() and p.name.startswith("n")]
+    assert len(builds) == 1 and (builds[0] / "main.sha256").is_file()
+
+
+@pytest.mark.parametrize("damage", ["truncate", "empty"])
+def test_a_damaged_binary_is_rebuilt_with_a_notice(capsys, monkeypatch, damage):
+    used = []
+    activate = engine._activate
+    monkeypatch.setattr(engine, "_activate", lambda key: used.append(activate(key)) or used[-1])
+    first = integrate(_current(), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")
+    build = used[-1]
+    main = build.directory / "main"
+    data = main.read_bytes()
+    main.write_bytes(data[: len(data) // 2] if damage == "truncate" else b"")
+    capsys.readouterr()
+    again = integrate(_current(), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")
+    err = capsys.readouterr().err
+    assert "does not match its recorded digest (damaged or replaced): rebuilding it" in err
+    np.testing.assert_array_equal(first.step, again.step)
+    assert engine._verified(build.directory)
+
+
+def test_an_unsafe_cache_directory_is_refused(tmp_path):
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o777)
+    with pytest.raises(ValueError, match="is writable by other users .*chmod go-w"):
+        private_dir(shared)
+    link = tmp_path / "link"
+    link.symlink_to(private_dir(tmp_path / "real"))
+    with pytest.raises(ValueError, match="must be a directory, not a symlink"):
+        private_dir(link)
+    assert oct(os.stat(private_dir(tmp_path / "new" / "deep")).st_mode & 0o777) == "0o700"
