@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ddmm.models._resources import check_memory
 from ddmm.models._validation import check_choice, check_positive
 from ddmm.models.attenuation import F_TH, NO_SHEAR_READINGS
 from ddmm.models.current_filters import check_fs
@@ -27,6 +28,7 @@ from ddmm.models.fused import FusedPipeline, mixing_matrix
 from ddmm.population._extras import require
 from ddmm.population.anatomy.receptive_fields import frame_theta, local_mixing
 from ddmm.population.runtime.noise import noise_key, root_seed
+from ddmm.population.runtime.plan import _BYTES_PER_ELEMENT as _PLAN_BYTES_PER_ELEMENT
 from ddmm.population.runtime.plan import RECORD_CHOICES, make_plan
 from ddmm.population.sampling import Population
 from ddmm.population.stimuli.scenes import Scene
@@ -230,7 +232,9 @@ def _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_si
     get_engine(engine)
     check_choice(method, "method", METHODS)
     check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
-    substeps_for(scenes[0].fs, check_positive(dt, "dt", "s"))
+    if check_positive(dt, "dt", "s") < MIN_DT:
+        raise ValueError(f"dt must be >= {MIN_DT:g} s (1 us; Euler's error at 0.1 ms is already 0.8%), got {dt:g}")
+    substeps_for(scenes[0].fs, dt)
     for name, value in (("trials", trials), ("chunk_size", chunk_size), ("time_chunk", time_chunk)):
         if name == "chunk_size" and value is None:
             continue  # the engine's default
@@ -379,6 +383,7 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
                         chunk_size=chunk_size, time_chunk=time_chunk, plan=plan, engine=engine,
                         scheduler=scheduler)
     check_fs(scenes[0].fs, population.current, tuple(np.unique(population.afferent_type[the_plan.selected])))
+    _check_run_memory(population, scenes, the_plan, trials)
     spikes = [[] for _ in scenes]
     members = [_unit_members(cond) for cond in the_plan.conditions]
     work = list(_jobs(population, scenes, the_plan))
@@ -391,6 +396,18 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
     ds = build_dataset(population, scenes, the_plan, spikes, config)
     ds.attrs.update(choice)
     return ds
+
+
+#: The smallest integration step accepted, s.
+MIN_DT = 1e-6
+
+
+def _check_run_memory(population, scenes, the_plan, trials) -> None:
+    """Refuse, before any work, a run whose counts and working set cannot fit (`ddmm.models._resources`)."""
+    counts = 4.0 * len(scenes) * trials * len(population)  # spike_count, int32
+    working = the_plan.chunk_size * the_plan.time_chunk * _PLAN_BYTES_PER_ELEMENT * max(1, os.cpu_count() or 1)
+    check_memory(counts + working, f"a run of {len(scenes)} condition(s) x {trials:,} trial(s) x {len(population):,} "
+                 "afferents", "use fewer trials, afferents or conditions, or split the run")
 
 
 def _progress_disabled(quiet: bool):

@@ -74,6 +74,10 @@ __all__ = [
 #: NAP choices of a population: the three profiles and "none" (untuned, CMM).
 NAP_CHOICES = PROFILE_NAMES + (UNTUNED,)
 PRESETS = ("fingertip", "hand")
+#: Bounds of a type's afferent count and density: far above the human hand (about 17,000; fingertip
+#: about 241 per cm^2) and below what a process can sample.
+MAX_COUNT = 1_000_000
+MAX_DENSITY_PER_CM2 = 10_000.0
 #: Maps a spec may name in ``[map]``.
 MAPS = ("hand",)
 _ANGLE_KINDS = ("uniform", "von_mises", "fixed", "list")
@@ -295,10 +299,15 @@ class TypeSpec:
     def __post_init__(self):
         if self.count is not None and self.density_per_cm2 is not None:
             _fail("count", "give exactly one of count and density_per_cm2")
-        if self.count is not None and (isinstance(self.count, bool) or not isinstance(self.count, int) or self.count < 0):
-            _fail("count", f"must be a whole number >= 0, got {self.count!r}")
+        if self.count is not None and (isinstance(self.count, bool) or not isinstance(self.count, int)
+                                       or not 0 <= self.count <= MAX_COUNT):
+            _fail("count", f"must be a whole number in [0, {MAX_COUNT:,}] (a hand has about 17,000 afferents), "
+                           f"got {self.count!r}")
         if self.density_per_cm2 is not None:
             _finite("density_per_cm2", self.density_per_cm2, nonneg=True)
+            if self.density_per_cm2 > MAX_DENSITY_PER_CM2:
+                _fail("density_per_cm2", f"must be <= {MAX_DENSITY_PER_CM2:g} per cm^2 (the human fingertip has "
+                                         f"about 241), got {self.density_per_cm2:g}")
         for name in self.nap:
             if name not in NAP_CHOICES:
                 _fail(f"nap.{name}", f"unknown NAP; allowed: {', '.join(NAP_CHOICES)}")

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ddmm.models._resources import check_memory
 from ddmm.models._validation import check_positive, parse_number
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Contact, Scene
@@ -110,6 +111,9 @@ def _uniform(path, t, data: dict, gaps: str) -> tuple:
         i = int(np.flatnonzero(gap)[0])
         raise ValueError(f"scene file {str(path)!r}: a gap of {float(step[i]):g} s at t = {float(t[i]):g} s "
                          f"(line {i + 2}; samples every {median:g} s); use gaps='interpolate' (--gaps interpolate) to fill it")
+    span = float(t[-1] - t[0])
+    check_memory(64.0 * (span / median + 1), f"scene file {str(path)!r} ({span:g} s sampled every {median:g} s)",
+                 "check its time column and --time-scale")
     if not np.any(gap) and np.all(np.abs(step - median) <= _JITTER * median):
         return 1.0 / median, data
     grid = t[0] + np.arange(int(math.floor((t[-1] - t[0]) / median + 1e-9)) + 1) * median
@@ -210,6 +214,9 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
     forces = np.column_stack([data["fx"] * scale, data["fy"] * scale, data["fz"] * scale * fz_sign])
     forces = _negative(path, forces[:, 2], forces, negative_fz, conditioning, fs_in)
     warn_band(Path(path).name, fs_in, stacklevel=3)
+    n_out = forces.shape[0] * fs / fs_in
+    check_memory(64.0 * n_out, f"scene file {str(path)!r} resampled to {fs:g} Hz ({n_out:,.0f} samples)",
+                 "check its time column and --time-scale")
     if conditioning is None:
         out = _pchip(forces, fs_in, fs)
     else:

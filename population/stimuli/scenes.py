@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ddmm.models._resources import check_memory
 from ddmm.models._validation import as_finite_array, check_positive
 
 __all__ = [
@@ -293,7 +294,12 @@ def _check_delay(shear_delay_s, ramp_s) -> None:
 
 
 def _samples(duration: float, fs: float) -> np.ndarray:
+    check_positive(fs, "fs", "Hz")
+    if not (np.isfinite(duration) and duration > 0):
+        raise ValueError(f"a scene's duration must be a finite number of seconds > 0, got {duration!r}")
     n = int(round(duration * fs))
+    # the times, three forces and the builders' temporaries: about eight float64 arrays of n samples
+    check_memory(64.0 * n, f"a scene of {duration:g} s at {fs:g} Hz ({n:,} samples)", "shorten it or lower fs")
     return np.arange(n) / fs
 
 
