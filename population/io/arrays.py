@@ -214,9 +214,12 @@ def _read_npz(path, where: str) -> dict:
     import zipfile
 
     try:
-        with np.load(path, allow_pickle=False) as data:
+        data = np.load(path, allow_pickle=False)
+        if not hasattr(data, "files"):  # a bare .npy array, not an archive of named fields
+            raise ValueError("it is a single array, not an archive of named fields")
+        with data:
             fields = {k: data[k] for k in data.files}
-    except (OSError, ValueError, zipfile.BadZipFile) as exc:
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
         raise ValueError(f"{where}: cannot be read as NPZ ({exc})") from None
     unknown = sorted(set(fields) - set(_REQUIRED) - set(_OPTIONAL))
     if unknown:
