@@ -22,7 +22,7 @@ import numpy as np
 from ddmm.models._resources import check_memory
 from ddmm.models._validation import check_positive, parse_number
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
-from ddmm.population.stimuli.scenes import DEFAULT_FS, Contact, Scene
+from ddmm.population.stimuli.scenes import DEFAULT_FS, MAX_FS, Contact, Scene
 
 __all__ = ["from_csv", "warn_band", "UNITS", "RECORDED", "RecordingBandWarning", "NEGATIVE_FZ", "GAPS",
            "FA_II_MIN_FS"]
@@ -210,6 +210,9 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
         if t.size < 2:
             raise ValueError(f"scene file {str(path)!r} needs at least 2 samples, got {t.size}")
         fs_in, data = _uniform(path, t, data, gaps)
+    if fs_in > MAX_FS:
+        raise ValueError(f"scene file {str(path)!r} is sampled at {fs_in:g} Hz, beyond any force sensor (<= "
+                         f"{MAX_FS:g} Hz): check its time column, --time-scale or --fs")
     scale = UNITS[units] * check_positive(force_scale, "force_scale")
     forces = np.column_stack([data["fx"] * scale, data["fy"] * scale, data["fz"] * scale * fz_sign])
     forces = _negative(path, forces[:, 2], forces, negative_fz, conditioning, fs_in)

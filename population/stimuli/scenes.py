@@ -16,6 +16,9 @@ from ddmm.models._validation import as_finite_array, check_positive
 
 __all__ = [
     "DEFAULT_FS",
+    "MAX_FS",
+    "MAX_RADIUS_MM",
+    "MAX_INCLINATION_DEG",
     "Contact",
     "Sites",
     "taxel_radius",

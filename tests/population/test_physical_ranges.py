@@ -46,6 +46,13 @@ def test_csv_rejects_python_only_numbers_and_non_utf8(tmp_path):
         from_csv(path)
 
 
+def test_csv_time_steps_beyond_any_sensor_are_refused(tmp_path):
+    path = tmp_path / "tiny.csv"
+    path.write_text("time,fx,fy,fz\n0,0,0,1\n1e-300,0,0,1\n2e-300,0,0,1\n")
+    with pytest.raises(ValueError, match=r"tiny.csv' is sampled at 1e\+300 Hz, beyond any force sensor"):
+        from_csv(path)
+
+
 def test_toml_too_deep_or_not_utf8_names_the_file(tmp_path):
     deep = tmp_path / "deep.toml"
     deep.write_text("[a]\nx = " + "[" * 5000 + "]" * 5000 + "\n")
