@@ -27,7 +27,8 @@ def add_recording_options(p, *, stream: bool = False) -> None:
                        help="a negative normal force beyond sensor noise: an error (default), clipped, or the "
                             "first 0.1 s taken as the sensor's zero offset")
         g.add_argument("--gaps", choices=GAPS, default="error", help="gaps in the time column: refused or filled")
-    g.add_argument("--units", choices=tuple(UNITS), default="N", help="force unit of the input (default N)")
+    g.add_argument("--units", choices=tuple(UNITS), default=None if stream else "N",
+                   help="force unit of the input (default N" + ("; an LSL stream's declared unit)" if stream else ")"))
     g.add_argument("--fz-sign", type=int, choices=(1, -1), default=1,
                    help="-1 for a sensor that reports pressing as negative F_Z")
     g.add_argument("--conditioning", choices=("causal", "zero_phase", "off"), default="causal",

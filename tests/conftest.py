@@ -1,6 +1,7 @@
 """Shared test settings: hypothesis profiles and an isolated Brian2 build cache."""
 
 import os
+import tempfile
 
 from hypothesis import HealthCheck, settings
 
@@ -12,3 +13,12 @@ settings.register_profile("ci", max_examples=40, deadline=None, derandomize=True
 settings.load_profile("ci" if os.environ.get("CI") else "default")
 
 ENGINES = ("direct", "brian2")
+
+# Lab Streaming Layer: loopback only, whatever the host's config.  liblsl reads the file named by
+# LSLAPICFG on first use, so it is set here, before any test imports pylsl (and inherited by the
+# `ddmm` subprocesses the tests start).
+_LSL_CONFIG = os.path.join(tempfile.mkdtemp(prefix="ddmm-lsl-"), "lsl_api.cfg")
+with open(_LSL_CONFIG, "w", encoding="utf-8") as _f:
+    _f.write("[ports]\nIPv6 = disable\n[multicast]\nResolveScope = machine\n[lab]\nKnownPeers = {127.0.0.1}\n"
+             "[log]\nlevel = -3\n")
+os.environ["LSLAPICFG"] = _LSL_CONFIG

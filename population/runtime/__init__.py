@@ -4,7 +4,9 @@
 - `noise`: counter-based current noise, keyed so chunking never changes it;
 - `stream`: the streaming encoder (`Encoder`), live force in, spikes out;
 - `step_choice`: the (dt, method) that meets an accuracy tolerance;
-- `distributed`: a run's afferent blocks as Dask tasks.
+- `distributed`: a run's afferent blocks as Dask tasks;
+- `lsl`, `lsl_bridge`: Lab Streaming Layer streams (forces in, spikes out) and
+  the bridge between them and an `Encoder` (extra ``ddmm[lsl]``).
 """
 
 from ddmm.models._lazy import lazy_exports
@@ -15,5 +17,8 @@ _WHERE = {
     "stream": ("Encoder", "StreamSpikes"),
     "step_choice": ("choose_setting", "load_table"),
     "distributed": ("dask_client",),
+    "lsl": ("ForceStream", "SpikeOutlet", "open_force_stream", "open_force_outlet", "read_spike_metadata",
+            "lsl_clock"),
+    "lsl_bridge": ("Bridge", "BridgeSummary", "check_stamps", "play_forces"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

@@ -129,6 +129,7 @@ class Encoder:
         idx = _type_positions(population, types)
         check_fs(self.model_fs, population.current, tuple(np.unique(population.afferent_type[idx])))
         self._order = idx[_grouped(population, idx, np.arange(idx.size))]  # contiguous (type, NAP) groups, as offline
+        self.population = population
         self._pop = population.select(self._order)
         self._precompute()
         self._engine.prepare()
@@ -166,6 +167,11 @@ class Encoder:
 
     def wait_ready(self) -> None:
         """Nothing to prepare: noise is drawn on demand (kept so real-time loops written for it still run)."""
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Positions in ``population`` of the afferents the encoder simulates (its ``types``), in its order."""
+        return self._order.copy()
 
     @property
     def n_samples(self) -> int:

@@ -16,6 +16,6 @@ _WHERE = {
                "rotating_shear", "taxel_radius"),
     "recordings": ("from_csv", "RecordingBandWarning", "UNITS"),
     "conditioning": ("Conditioning", "Conditioner", "condition_forces"),
-    "site_scenes": ("contact_grid", "grasp", "incipient_slip", "torsion"),
+    "site_scenes": ("contact_grid", "digit_tip_sites", "grasp", "incipient_slip", "torsion"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

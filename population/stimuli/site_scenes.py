@@ -57,7 +57,7 @@ import numpy as np
 from ddmm.models._validation import check_positive
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Scene, Sites, Stage, taxel_radius
 
-__all__ = ["contact_grid", "torsion", "incipient_slip", "grasp"]
+__all__ = ["contact_grid", "torsion", "incipient_slip", "grasp", "digit_tip_sites"]
 
 
 def contact_grid(radius_mm: float, pitch_mm: float, *, center_mm=(0.0, 0.0), region: str = ""):
@@ -206,6 +206,27 @@ def incipient_slip(normal_n: float = 2.0, *, mu_s: float = 1.0, mu_k: float = 0.
     return Scene.from_sites(forces, sites, fs, label, tuple(stages), direction_deg)
 
 
+def digit_tip_sites(digits=("D1", "D2", "D3", "D4", "D5")) -> Sites:
+    """One site on each digit tip's pad centre (region ``D<n>d``), a footprint of the reference contact area.
+
+    The hand frame of `ddmm.population.anatomy.hand_map`; the sites `grasp`
+    uses, and those of a five-sensor glove streamed live (``ddmm stream
+    --sites fingertips``).  Site ids are the region names.
+
+    Examples
+    --------
+    >>> digit_tip_sites(("D1", "D2")).site_id.tolist()
+    ['D1d', 'D2d']
+    """
+    from ddmm.population.anatomy.hand_map import get_region
+    from ddmm.population.anatomy.receptive_fields import REFERENCE_AREA_MM2
+
+    tips = [get_region(f"{d}d") for d in digits]
+    radius = float(np.sqrt(REFERENCE_AREA_MM2 / np.pi))
+    return Sites([tip.center_mm[0] for tip in tips], [tip.center_mm[1] for tip in tips], radius,
+                 region=[tip.name for tip in tips], site_id=[tip.name for tip in tips])
+
+
 def grasp(digits=("D1", "D2"), *, load_n: float = 2.0, mu: float = 1.0, safety: float = 1.4,
           preload_n: float = 0.3, load_direction_deg: float = 270.0, preload_s: float = 0.1,
           loading_s: float = 0.3, hold_s: float = 1.0, replace_s: float = 0.3, release_s: float = 0.1,
@@ -219,8 +240,8 @@ def grasp(digits=("D1", "D2"), *, load_n: float = 2.0, mu: float = 1.0, safety: 
     (5, ['preload', 'loading', 'hold'])
     """
     from ddmm.population.anatomy.hand_map import get_region
-    from ddmm.population.anatomy.receptive_fields import REFERENCE_AREA_MM2
 
+    sites = digit_tip_sites(digits)
     tips = [get_region(f"{d}d") for d in digits]
     for value, label in ((load_n, "load_n"), (mu, "mu"), (safety, "safety"), (preload_n, "preload_n")):
         check_positive(value, label, "N or 1")
@@ -234,9 +255,6 @@ def grasp(digits=("D1", "D2"), *, load_n: float = 2.0, mu: float = 1.0, safety: 
     for j, tip in enumerate(tips):
         rad = np.deg2rad(load_direction_deg + tip.frame_deg)
         forces[:, j, 0], forces[:, j, 1], forces[:, j, 2] = load * np.cos(rad), load * np.sin(rad), normal
-    radius = float(np.sqrt(REFERENCE_AREA_MM2 / np.pi))
-    sites = Sites([tip.center_mm[0] for tip in tips], [tip.center_mm[1] for tip in tips], radius,
-                  region=[tip.name for tip in tips], site_id=[tip.name for tip in tips])
     labels = ("preload", "loading", "hold", "replacement", "release")
     stages = tuple(Stage(lab, float(a), float(b)) for lab, a, b in zip(labels, knots[:-1], knots[1:]))
     return Scene.from_sites(forces, sites, fs, name or f"grasp_{n}digits_{load_n:g}N", stages)

@@ -1,0 +1,402 @@
+"""Lab Streaming Layer (LSL) streams: a live force stream in, a spike stream out.
+
+Needs the optional extra ``ddmm[lsl]`` (pylsl, which bundles liblsl);
+without it, every function here raises an ImportError that names the
+install command.
+
+**The force stream** a sensor publishes: ``3 n_sites`` numeric channels,
+(F_X, F_Y, F_Z) of each site in turn, at a regular rate (an irregular stream
+needs ``fs``).  Units are read from the XDF meta-data
+(``desc/channels/channel/unit``: N, mN, gf, kgf, lbf, or their names) or
+given as ``units``; channel labels that name axes (``Fx``, ``force_z``, ...)
+are checked to be in that order.  `open_force_stream` resolves it by name.
+
+**The spike stream** (`SpikeOutlet`): type ``Spikes``, one int32 channel,
+irregular rate; **one sample per spike, holding the afferent's id** (the
+``afferent`` coordinate of `simulate`'s Dataset), **stamped with the spike's
+time on the input stream's clock**: the capture stamp of the first force
+sample, mapped to this host's LSL clock, plus the spike's model time (a
+reported gap in the input moves the anchor by the gap's length,
+`ddmm.population.runtime.lsl_bridge`).  Spikes of one step go out in
+increasing id.  Its meta-data (`read_spike_metadata`) describe the
+population (id, type, position, region, theta_T and NAP of each afferent),
+the model settings and the input stream.
+
+**A force outlet** for tests, demos and replaying recordings:
+`open_force_outlet`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ddmm.models._validation import check_positive
+from ddmm.population._extras import require
+from ddmm.population.stimuli.recordings import UNITS
+
+__all__ = ["SPIKE_STREAM_TYPE", "FORCE_STREAM_TYPE", "ForceStream", "SpikeOutlet", "open_force_stream",
+           "open_force_outlet", "read_spike_metadata", "lsl_clock"]
+
+SPIKE_STREAM_TYPE = "Spikes"
+FORCE_STREAM_TYPE = "Force"
+#: Unit names a force stream may declare, case-insensitively, and the unit of `UNITS` each means.
+UNIT_NAMES = {**{u.lower(): u for u in UNITS}, "newton": "N", "newtons": "N", "millinewton": "mN",
+              "millinewtons": "mN", "gram-force": "gf", "kilogram-force": "kgf", "pound-force": "lbf"}
+_ROUND_S = 0.25  # one resolve round, s
+_NUMERIC = {1: "float32", 2: "double64", 4: "int32", 5: "int16", 6: "int8", 7: "int64"}
+
+
+def _pylsl(caller: str):
+    return require("pylsl", caller, "lsl")
+
+
+def lsl_clock() -> float:
+    """This host's LSL clock in seconds (``pylsl.local_clock``), the clock stamps are given in."""
+    return float(_pylsl("lsl_clock").local_clock())
+
+
+@dataclass(frozen=True)
+class ForceStream:
+    """A resolved force stream, opened for reading.
+
+    Attributes
+    ----------
+    name, source_id, hostname : str
+        The stream's identity as LSL reports it.
+    fs : float
+        Sample rate in Hz (the stream's nominal rate, or the one given).
+    n_sites : int
+        Force sites (the stream has ``3 n_sites`` channels).
+    unit : str
+        The force unit of the samples (a key of `ddmm.population.stimuli.recordings.UNITS`).
+    fz_sign : int
+        -1 for a sensor that reports pressing as negative F_Z.
+    clock_offset_s : float
+        What to add to the stream's stamps to read them on this host's LSL
+        clock (LSL's time correction, measured when the stream opened).
+    inlet : pylsl.StreamInlet
+        The open inlet (no clock processing: stamps are the sender's).
+    """
+
+    name: str
+    source_id: str
+    hostname: str
+    fs: float
+    n_sites: int
+    unit: str
+    fz_sign: int
+    clock_offset_s: float
+    inlet: object
+
+    @property
+    def scale(self) -> np.ndarray:
+        """Per-channel factor to newtons in the package's frame (units and sign), shape (3 n_sites,)."""
+        one = np.array([1.0, 1.0, float(self.fz_sign)]) * UNITS[self.unit]
+        return np.tile(one, self.n_sites)
+
+    def close(self) -> None:
+        """Close the inlet (the stream itself belongs to its sender)."""
+        self.inlet.close_stream()
+
+
+def _resolve(pylsl, name: str, source_id: str | None, timeout: float):
+    predicate = f"name='{name}'" + ("" if source_id is None else f" and source_id='{source_id}'")
+    deadline, found = time.monotonic() + timeout, []
+    while not found and time.monotonic() < deadline:
+        # Short rounds: liblsl (1.18.0b6) takes some timeouts near 0.5 s as 5.5 s, and a round ends early when found.
+        found = pylsl.resolve_bypred(predicate, 1, min(_ROUND_S, max(deadline - time.monotonic(), 0.01)))
+    if not found:
+        raise ValueError(f"no LSL stream named {name!r}" + ("" if source_id is None else f" with source id "
+                         f"{source_id!r}") + f" found within {timeout:g} s (is its sender running on this network?)")
+    if len({(s.source_id(), s.hostname()) for s in found}) > 1:
+        ids = ", ".join(sorted(repr(s.source_id()) for s in found))
+        raise ValueError(f"{len(found)} LSL streams are named {name!r} (source ids {ids}): give a source id")
+    return found[0]
+
+
+def _channel_units_labels(info) -> tuple[list, list]:
+    units, labels = [], []
+    channel = info.desc().child("channels").child("channel")
+    while not channel.empty():
+        units.append(channel.child_value("unit").strip())
+        labels.append(channel.child_value("label").strip())
+        channel = channel.next_sibling("channel")
+    return units, labels
+
+
+def _stream_unit(name: str, declared: list, units: str | None) -> str:
+    """The unit: the one the stream declares (all channels alike) or the one given; they must agree."""
+    names = {u for u in declared if u}
+    unknown = sorted(u for u in names if u.lower() not in UNIT_NAMES)
+    if unknown:
+        raise ValueError(f"LSL stream {name!r} declares the force unit {unknown[0]!r}; known: {', '.join(UNITS)}")
+    found = {UNIT_NAMES[u.lower()] for u in names}
+    if len(found) > 1:
+        raise ValueError(f"LSL stream {name!r} declares mixed force units {sorted(found)}: one unit for all channels")
+    if units is not None and units not in UNITS:
+        raise ValueError(f"units={units!r} is not allowed; allowed: {', '.join(UNITS)}")
+    if units is not None and found and units not in found:
+        raise ValueError(f"LSL stream {name!r} declares its forces in {found.pop()}, not units={units!r}")
+    return units or (found.pop() if found else "N")
+
+
+def _check_labels(name: str, labels: list) -> None:
+    """Channel labels that all name an axis (``Fx``, ``D2d_fz``, ``force_Y``) must run x, y, z per site."""
+    axes = [re.search(r"([xyz])$", label.lower()) for label in labels]
+    if not labels or not all(labels) or not all(axes):
+        return
+    for i, match in enumerate(axes):
+        if match.group(1) != "xyz"[i % 3]:
+            raise ValueError(f"LSL stream {name!r}: channel {i} is labelled {labels[i]!r}, but channels must be "
+                             f"F_X, F_Y, F_Z of each site in turn (channel {i} is F_{'XYZ'[i % 3]})")
+
+
+def _stream_rate(name: str, nominal: float, fs: float | None) -> float:
+    if nominal <= 0.0:
+        if fs is None:
+            raise ValueError(f"LSL stream {name!r} has an irregular rate: give its sample rate (fs)")
+        return check_positive(fs, "fs", "Hz")
+    if fs is not None and abs(check_positive(fs, "fs", "Hz") - nominal) > 1e-3 * nominal:
+        raise ValueError(f"fs={float(fs):g} Hz disagrees with LSL stream {name!r}'s nominal rate {nominal:g} Hz")
+    return float(nominal)
+
+
+def open_force_stream(name: str, *, n_sites: int = 1, fs: float | None = None, units: str | None = None,
+                      fz_sign: int = 1, source_id: str | None = None, timeout: float = 5.0) -> ForceStream:
+    """Resolve a force stream by name, check it, and open an inlet on it.
+
+    Parameters
+    ----------
+    name : str
+        The stream's LSL name.
+    n_sites : int
+        Force sites the stream carries (``3 n_sites`` channels).
+    fs : float, optional
+        Sample rate in Hz: needed for an irregular-rate stream, checked
+        against a regular stream's nominal rate.
+    units : str, optional
+        Force unit (a key of ``UNITS``); default what the stream declares, else N.
+    fz_sign : {1, -1}
+        -1 for a sensor that reports pressing as negative F_Z.
+    source_id : str, optional
+        Pick one of several streams of this name.
+    timeout : float
+        Seconds to wait for the stream to resolve and open.
+
+    Raises
+    ------
+    ValueError
+        No such stream within ``timeout``, several, a wrong channel count
+        or format, an unknown or contradicting unit, mislabelled channels.
+
+    Examples
+    --------
+    >>> outlet = open_force_outlet("ddmm-doc-forces", fs=1000.0, units="mN")  # doctest: +SKIP
+    >>> stream = open_force_stream("ddmm-doc-forces", timeout=2.0)  # doctest: +SKIP
+    >>> stream.unit, stream.fs  # doctest: +SKIP
+    ('mN', 1000.0)
+    """
+    pylsl = _pylsl("open_force_stream")
+    timeout = check_positive(timeout, "timeout", "s")
+    if isinstance(n_sites, bool) or not isinstance(n_sites, (int, np.integer)) or n_sites < 1:
+        raise ValueError(f"n_sites must be a positive integer, got {n_sites!r}")
+    if fz_sign not in (1, -1):
+        raise ValueError(f"fz_sign must be 1 or -1, got {fz_sign!r}")
+    found = _resolve(pylsl, name, source_id, timeout)
+    if found.channel_count() != 3 * n_sites:
+        raise ValueError(f"LSL stream {name!r} has {found.channel_count()} channels; {n_sites} site(s) need "
+                         f"{3 * n_sites} (F_X, F_Y, F_Z per site)")
+    if found.channel_format() not in _NUMERIC:
+        raise ValueError(f"LSL stream {name!r} carries strings, not forces (a numeric channel format is needed)")
+    rate = _stream_rate(name, found.nominal_srate(), fs)
+    inlet = pylsl.StreamInlet(found, max_buflen=360, recover=False)
+    try:
+        full = inlet.info(timeout=timeout)
+        declared, labels = _channel_units_labels(full)
+        unit = _stream_unit(name, declared, units)
+        _check_labels(name, labels)
+        inlet.open_stream(timeout=timeout)
+        # Ask once now: the first correction takes a few exchanges, and a pull waiting on it would stall.
+        offset = inlet.time_correction(timeout=timeout)
+    except Exception:
+        inlet.close_stream()
+        raise
+    return ForceStream(name, found.source_id(), found.hostname(), rate, int(n_sites), unit, int(fz_sign),
+                       float(offset), inlet)
+
+
+def open_force_outlet(name: str, *, fs: float, n_sites: int = 1, units: str = "N", source_id: str | None = None,
+                      site_ids=None):
+    """A force outlet as `open_force_stream` reads it: ``3 n_sites`` float64 channels at ``fs``.
+
+    For a synthetic sensor, a replayed recording or a test; the channels are
+    labelled ``Fx, Fy, Fz`` (``<site>_Fx``, ... with ``site_ids``) with
+    ``units`` declared, in the XDF meta-data's ``desc/channels``.
+
+    Returns
+    -------
+    pylsl.StreamOutlet
+        Push (n, 3 n_sites) chunks with ``push_chunk(samples, stamps)``.
+
+    Examples
+    --------
+    >>> outlet = open_force_outlet("ddmm-doc-sensor", fs=100.0, units="mN")  # doctest: +SKIP
+    """
+    pylsl = _pylsl("open_force_outlet")
+    if units not in UNITS:
+        raise ValueError(f"units={units!r} is not allowed; allowed: {', '.join(UNITS)}")
+    sites = [str(s) for s in site_ids] if site_ids is not None else None
+    if sites is not None and len(sites) != n_sites:
+        raise ValueError(f"site_ids must name {n_sites} site(s), got {len(sites)}")
+    sid = source_id or "ddmm-force-" + hashlib.sha256(f"{name}/{fs}/{n_sites}/{units}".encode()).hexdigest()[:12]
+    info = pylsl.StreamInfo(name, FORCE_STREAM_TYPE, 3 * n_sites, check_positive(fs, "fs", "Hz"),
+                            pylsl.cf_double64, sid)
+    channels = info.desc().append_child("channels")
+    for site in range(n_sites):
+        for axis in "xyz":
+            channel = channels.append_child("channel")
+            channel.append_child_value("label", (f"{sites[site]}_" if sites else "") + f"F{axis}")
+            channel.append_child_value("unit", units)
+            channel.append_child_value("type", "Force")
+    info.desc().append_child("acquisition").append_child_value("manufacturer", "ddmm")
+    return pylsl.StreamOutlet(info)
+
+
+def _text(values, fmt=str) -> str:
+    return ",".join(fmt(v) for v in values)
+
+
+class SpikeOutlet:
+    """The spike stream of a streaming encoder (see the module docstring for its convention).
+
+    Parameters
+    ----------
+    name : str
+        The stream's LSL name.
+    encoder : Encoder
+        The encoder whose spikes go out (its population, settings and sites
+        are described in the meta-data).
+    force : ForceStream, optional
+        The input stream (named in the meta-data).
+    source_id : str, optional
+        Default: derived from ``name``, the population and the seed, so a
+        restarted bridge keeps its id and recorders reconnect to it.
+
+    Examples
+    --------
+    >>> from ddmm.population import make_population  # doctest: +SKIP
+    >>> from ddmm.population.runtime import Encoder  # doctest: +SKIP
+    >>> outlet = SpikeOutlet("ddmm-doc-spikes", Encoder(make_population(["SAI"]), fs=1000.0))  # doctest: +SKIP
+    """
+
+    def __init__(self, name: str, encoder, *, force: ForceStream | None = None, source_id: str | None = None):
+        pylsl = _pylsl("SpikeOutlet")
+        ids = encoder.population.afferent_id[encoder.positions]
+        digest = hashlib.sha256(f"{name}/{encoder.population.name}/{encoder.seed}/{_text(ids)}".encode())
+        self.source_id = source_id or "ddmm-spikes-" + digest.hexdigest()[:12]
+        info = pylsl.StreamInfo(name, SPIKE_STREAM_TYPE, 1, pylsl.IRREGULAR_RATE, pylsl.cf_int32, self.source_id)
+        _describe(info.desc(), encoder, force)
+        self.name = name
+        self._ids = encoder.population.afferent_id.astype(np.int32)
+        self._outlet = pylsl.StreamOutlet(info)
+
+    def push(self, positions, stamps) -> None:
+        """Send spikes: the afferents' positions in the encoder's population and their LSL stamps (s)."""
+        if len(positions):
+            self._outlet.push_chunk(self._ids[np.asarray(positions)][:, None], np.asarray(stamps, float).tolist())
+
+    def have_consumers(self) -> bool:
+        """Whether any inlet is connected."""
+        return bool(self._outlet.have_consumers())
+
+    def close(self) -> None:
+        """Withdraw the stream (consumers see it end)."""
+        del self._outlet
+
+
+def _describe(desc, encoder, force) -> None:
+    """The spike stream's meta-data: the channel, the convention, the model, the input and the population."""
+    from ddmm import __version__
+
+    channel = desc.append_child("channels").append_child("channel")
+    channel.append_child_value("label", "afferent_id")
+    channel.append_child_value("type", "SpikeID")
+    channel.append_child_value("unit", "1")
+    desc.append_child_value("convention", "one sample per spike: the afferent id; stamp: the spike time on the "
+                            "input stream's clock (first sample's stamp + model time, moved on by reported gaps)")
+    model = desc.append_child("model")
+    settings = {"software": f"ddmm {__version__}", "population": encoder.population.name, "seed": str(encoder.seed),
+                "engine": encoder.engine, "method": encoder.method, "dt_s": repr(encoder.dt),
+                "model_fs_hz": repr(encoder.model_fs), "no_shear": encoder.no_shear,
+                "conditioning": repr(encoder.conditioning)}
+    for key, value in settings.items():
+        model.append_child_value(key, value)
+    if force is not None:
+        source = desc.append_child("input")
+        for key, value in (("name", force.name), ("source_id", force.source_id), ("hostname", force.hostname),
+                           ("fs_hz", repr(force.fs)), ("unit", force.unit), ("fz_sign", str(force.fz_sign)),
+                           ("clock_offset_s", repr(force.clock_offset_s))):
+            source.append_child_value(key, value)
+    pop, pos = encoder.population, encoder.positions
+    afferents = desc.append_child("afferents")
+    afferents.append_child_value("count", str(pos.size))
+    for key, values, fmt in (("id", pop.afferent_id[pos], str), ("type", pop.afferent_type[pos], str),
+                             ("x_mm", pop.x_mm[pos], repr), ("y_mm", pop.y_mm[pos], repr),
+                             ("region", pop.region[pos], str), ("theta_t_deg", pop.theta_t[pos], repr),
+                             ("nap", pop.nap[pos], str)):
+        afferents.append_child_value(key, _text(values, lambda v, f=fmt: f(v.item() if hasattr(v, "item") else v)))
+    if encoder.sites is not None:
+        sites = desc.append_child("sites")
+        for key, values in (("id", encoder.sites.site_id), ("x_mm", encoder.sites.x_mm),
+                            ("y_mm", encoder.sites.y_mm), ("radius_mm", encoder.sites.radius_mm),
+                            ("region", encoder.sites.region)):
+            sites.append_child_value(key, _text(values, lambda v: str(v.item() if hasattr(v, "item") else v)))
+
+
+def read_spike_metadata(info) -> dict:
+    """The population and settings a spike stream describes, from its full `pylsl.StreamInfo`.
+
+    Returns
+    -------
+    dict
+        ``afferents``: a dict of arrays (``id``, ``type``, ``x_mm``, ``y_mm``,
+        ``region``, ``theta_t_deg``, ``nap``), one entry per afferent; ``model``
+        and ``input``: dicts of strings; ``sites`` (when the encoder has sites).
+
+    Examples
+    --------
+    >>> inlet = pylsl.StreamInlet(pylsl.resolve_byprop("type", "Spikes")[0])  # doctest: +SKIP
+    >>> meta = read_spike_metadata(inlet.info())  # doctest: +SKIP
+    """
+    desc = info.desc()
+    if desc.child("afferents").empty():
+        raise ValueError(f"LSL stream {info.name()!r} carries no ddmm population description")
+    out = {}
+    for block in ("model", "input"):
+        node, values = desc.child(block), {}
+        child = node.first_child()
+        while not child.empty():
+            values[child.name()] = child.child_value()
+            child = child.next_sibling()
+        out[block] = values
+    out["afferents"] = _columns(desc.child("afferents"), ("id", "type", "x_mm", "y_mm", "region", "theta_t_deg", "nap"),
+                                {"id": np.int64, "x_mm": float, "y_mm": float, "theta_t_deg": float})
+    if not desc.child("sites").empty():
+        out["sites"] = _columns(desc.child("sites"), ("id", "x_mm", "y_mm", "radius_mm", "region"),
+                                {"x_mm": float, "y_mm": float, "radius_mm": float})
+    return out
+
+
+def _columns(node, keys, numeric) -> dict:
+    columns = {}
+    for key in keys:
+        text = node.child_value(key)
+        items = text.split(",") if text else []
+        columns[key] = np.array(items, dtype=numeric.get(key, object)) if key in numeric else np.array(items, object)
+    return columns
+

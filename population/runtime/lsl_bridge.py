@@ -1,0 +1,268 @@
+"""The LSL bridge: force samples from an LSL stream through a streaming `Encoder` to a spike sink.
+
+**Sample times come from LSL stamps, not from arrival.**  The encoder's clock
+counts samples, so when and in what chunks samples arrive never changes a
+spike: the spikes equal an offline run of the same samples (`Encoder` on the
+whole array, or `from_csv` + `simulate` with the same causal conditioning),
+bit for bit.  The stamps are checked by the rule of recorded streams
+(``ddmm stream``'s standard input): a sample stamped at or before the one
+before it is **out of order**, dropped and reported; an interval over
+1.5 / fs is a **gap**, reported with its time and length, after which the
+samples are taken as consecutive and the spike stamps' anchor moves on by the
+gap's excess, so spikes stay on the input's clock.  A sample the encoder
+refuses (a non-finite value, a normal force below the noise allowance) is
+skipped and reported, and counted as a one-sample gap.
+
+The bridge stops at the end of input (the sender withdraws its stream: LSL
+then discards what the inlet has not pulled, so a sender should close only
+once the bridge has caught up), when ``should_stop()`` turns true (a signal
+handler's flag), or after ``duration`` seconds of input.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ddmm.models._validation import check_positive
+from ddmm.population.runtime.lsl import ForceStream, _pylsl
+
+__all__ = ["GAP_FACTOR", "BridgeSummary", "Bridge", "check_stamps", "play_forces"]
+
+#: An interval between stamps over this many sample periods is a gap (as for recorded streams).
+GAP_FACTOR = 1.5
+
+
+@dataclass
+class BridgeSummary:
+    """What a bridge did: samples consumed, spikes sent, problems found, and why it stopped.
+
+    Attributes
+    ----------
+    samples, spikes : int
+        Input samples taken by the encoder; spikes sent to the sink.
+    gaps : list of (float, float)
+        (stamp of the sample before the gap on this host's LSL clock, gap length) in seconds.
+    out_of_order, skipped : int
+        Samples dropped for stamps that do not increase; samples the encoder refused.
+    stopped : str
+        ``"end of input"``, ``"duration"``, ``"stopped"`` (``should_stop``) or ``""`` while running.
+    """
+
+    samples: int = 0
+    spikes: int = 0
+    gaps: list = field(default_factory=list)
+    out_of_order: int = 0
+    skipped: int = 0
+    stopped: str = ""
+
+    def describe(self) -> str:
+        """One line for a log."""
+        return (f"{self.samples:,} samples in, {self.spikes:,} spikes out, {len(self.gaps)} gap(s), "
+                f"{self.out_of_order} out of order, {self.skipped} skipped" +
+                (f" ({self.stopped})" if self.stopped else ""))
+
+
+def check_stamps(stamps, last: float | None, fs: float):
+    """The rule for a chunk's stamps: which samples to keep, and the gap before each kept one.
+
+    Parameters
+    ----------
+    stamps : array_like, shape (n,)
+        The chunk's LSL stamps in seconds (sender's clock).
+    last : float or None
+        Stamp of the last sample kept before this chunk (None: this is the first).
+    fs : float
+        Sample rate in Hz.
+
+    Returns
+    -------
+    keep : ndarray of bool, shape (n,)
+        False for out-of-order samples (stamp <= the last kept stamp).
+    excess : ndarray of float, shape (n,)
+        For a kept sample after a gap (an interval over ``GAP_FACTOR / fs``),
+        the interval minus ``1 / fs``; else 0.
+
+    Examples
+    --------
+    >>> keep, excess = check_stamps([0.001, 0.002, 0.0015, 0.010], 0.0, 1000.0)
+    >>> keep.tolist(), [round(e, 6) for e in excess]
+    ([True, True, False, True], [0.0, 0.0, 0.0, 0.007])
+    """
+    stamps = np.asarray(stamps, dtype=float)
+    keep, excess = np.ones(stamps.size, bool), np.zeros(stamps.size)
+    previous = -np.inf if last is None else float(last)
+    for i, stamp in enumerate(stamps):  # sequential: a dropped sample is not the "previous" one
+        if not stamp > previous:
+            keep[i] = False
+            continue
+        if np.isfinite(previous) and stamp - previous > GAP_FACTOR / fs:
+            excess[i] = stamp - previous - 1.0 / fs
+        previous = stamp
+    return keep, excess
+
+
+class Bridge:
+    """Pull force samples from an LSL stream, encode them, and send the spikes on.
+
+    Parameters
+    ----------
+    encoder : Encoder
+        The streaming encoder, made with the stream's ``fs`` and sites.
+    force : ForceStream
+        The open force stream (`open_force_stream`).
+    sink : callable
+        ``sink(positions, stamps)``: the spiking afferents' positions in the
+        encoder's population and their stamps on this host's LSL clock (s);
+        a `SpikeOutlet`'s ``push``, for example.
+    report : callable, optional
+        ``report(message)`` for each gap, out-of-order or skipped sample.
+
+    Examples
+    --------
+    >>> bridge = Bridge(encoder, open_force_stream("sensor"), SpikeOutlet("spikes", encoder).push)  # doctest: +SKIP
+    >>> bridge.run(duration=10.0).describe()  # doctest: +SKIP
+    '10,000 samples in, 2,345 spikes out, 0 gap(s), 0 out of order, 0 skipped (duration)'
+    """
+
+    def __init__(self, encoder, force: ForceStream, sink, *, report=None):
+        if encoder.fs != force.fs:
+            raise ValueError(f"the encoder's fs ({encoder.fs:g} Hz) differs from the stream's ({force.fs:g} Hz)")
+        n_sites = 1 if encoder.sites is None else len(encoder.sites)
+        if n_sites != force.n_sites:
+            raise ValueError(f"the encoder has {n_sites} site(s), the stream {force.n_sites}")
+        self.encoder, self.force, self.sink = encoder, force, sink
+        self.report = report or (lambda message: None)
+        self.summary = BridgeSummary()
+        self._last = None  # last kept stamp, sender's clock
+        self._anchor = None  # this host's LSL time of model time 0, moved on by gaps
+        self._shape = (3,) if encoder.sites is None else (n_sites, 3)
+
+    def poll(self, timeout: float = 0.05, limit: int | None = None) -> int:
+        """Pull what has arrived (waiting up to ``timeout`` s for a first sample) and encode it.
+
+        ``limit`` caps the samples consumed.  Returns the samples consumed;
+        raises pylsl's ``LostError`` when the sender has gone.
+        """
+        samples, stamps = self.force.inlet.pull_chunk(timeout=timeout, max_samples=1024, min_samples=1,
+                                                      as_numpy=True)
+        if len(stamps) == 0:
+            return 0
+        return self.consume(np.asarray(samples, float), np.asarray(stamps, float), limit)
+
+    def consume(self, samples, stamps, limit: int | None = None) -> int:
+        """Encode a chunk of raw samples (stream units) with their stamps; returns the samples taken."""
+        keep, excess = check_stamps(stamps, self._last, self.force.fs)
+        for i in np.flatnonzero(~keep):
+            self.summary.out_of_order += 1
+            self.report(f"a sample stamped {stamps[i]:.6f} s comes at or before the one before it: dropped")
+        index = np.flatnonzero(keep)
+        if limit is not None:
+            index = index[:max(limit, 0)]
+        if index.size == 0:
+            return 0
+        if self._anchor is None:
+            self._anchor = float(stamps[index[0]]) + self.force.clock_offset_s
+        forces = samples[index] * self.force.scale
+        gaps = excess[index]
+        starts = sorted({0, *np.flatnonzero(gaps > 0).tolist()}) + [index.size]
+        for a, b in zip(starts[:-1], starts[1:]):
+            if gaps[a] > 0:
+                self._gap(float(stamps[index[a]]), float(gaps[a]))
+            self._push(forces[a:b])
+        self._last = float(stamps[index[-1]])
+        self.summary.samples += index.size
+        return int(index.size)
+
+    def _gap(self, stamp: float, excess: float) -> None:
+        before = stamp - excess - 1.0 / self.force.fs  # the stamp of the sample before the gap
+        self.summary.gaps.append((before + self.force.clock_offset_s, excess + 1.0 / self.force.fs))
+        self.report(f"a gap of {excess + 1.0 / self.force.fs:.6g} s after the sample stamped {before:.6f} s; "
+                    "the samples are taken as consecutive and the spike stamps move on by the gap")
+        self._anchor += excess
+
+    def _push(self, forces) -> None:
+        forces = forces.reshape((-1, *self._shape))
+        try:
+            spikes = self.encoder.push(forces)
+        except ValueError:  # find the refused samples; the encoder's state is untouched by a failed push
+            for row in forces:
+                try:
+                    self._send(self.encoder.push(row[None]))
+                except ValueError as exc:
+                    self.summary.skipped += 1
+                    self._anchor += 1.0 / self.force.fs
+                    self.report(f"a sample skipped: {exc}")
+            return
+        self._send(spikes)
+
+    def _send(self, spikes) -> None:
+        if spikes.afferent.size:
+            self.sink(spikes.afferent, self._anchor + spikes.time)
+            self.summary.spikes += int(spikes.afferent.size)
+
+    def run(self, *, duration: float | None = None, should_stop=None, poll_s: float = 0.05) -> BridgeSummary:
+        """Bridge until the end of input, ``should_stop()``, or ``duration`` seconds of input.
+
+        Returns the `BridgeSummary` (also kept as ``summary``).
+        """
+        lost = _pylsl("Bridge.run").util.LostError
+        limit = None if duration is None else int(round(check_positive(duration, "duration", "s") * self.force.fs))
+        while True:
+            if limit is not None and self.summary.samples >= limit:
+                self.summary.stopped = "duration"
+                break
+            if should_stop is not None and should_stop():
+                self.summary.stopped = "stopped"
+                break
+            try:
+                self.poll(poll_s, None if limit is None else limit - self.summary.samples)
+            except lost:
+                self.summary.stopped = "end of input"
+                break
+        return self.summary
+
+
+def play_forces(outlet, forces, fs: float, *, should_stop=None, start: float | None = None) -> int:
+    """Push ``forces`` to a force outlet in real time, each sample stamped with its due time.
+
+    Parameters
+    ----------
+    outlet : pylsl.StreamOutlet
+        From `open_force_outlet`.
+    forces : ndarray, shape (n, 3 n_sites)
+        Samples in the outlet's units.
+    fs : float
+        Sample rate in Hz.
+    should_stop : callable, optional
+        Polled between samples; True ends the playback early.
+    start : float, optional
+        LSL time of sample 0 (default: now).
+
+    Returns
+    -------
+    int
+        Samples pushed.
+
+    Examples
+    --------
+    >>> play_forces(open_force_outlet("sensor", fs=100.0), np.zeros((100, 3)), 100.0)  # doctest: +SKIP
+    100
+    """
+    pylsl = _pylsl("play_forces")
+    forces = np.ascontiguousarray(forces, dtype=float)
+    fs = check_positive(fs, "fs", "Hz")
+    t0 = pylsl.local_clock() if start is None else float(start)
+    for k in range(forces.shape[0]):
+        due = t0 + k / fs
+        wait = due - pylsl.local_clock()
+        if wait > 2e-3:
+            time.sleep(wait - 1e-3)  # sleep most of the wait, spin the last millisecond
+        while pylsl.local_clock() < due:
+            pass
+        if should_stop is not None and should_stop():
+            return k
+        outlet.push_chunk(forces[k:k + 1], [due])
+    return int(forces.shape[0])

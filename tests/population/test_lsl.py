@@ -1,0 +1,236 @@
+"""Lab Streaming Layer: the stamp rule, the bridge's bit-for-bit equality with offline runs, loopback streams.
+
+Loopback only (tests/conftest.py writes the LSL config and sets LSLAPICFG);
+every stream name is unique to its test, every wait is bounded.
+"""
+
+import threading
+import time
+import uuid
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ddmm.population import from_csv, sample_population, simulate
+from ddmm.population.runtime.lsl import (ForceStream, SpikeOutlet, open_force_outlet, open_force_stream,
+                                         read_spike_metadata)
+from ddmm.population.runtime.lsl_bridge import Bridge, check_stamps
+from ddmm.population.runtime.stream import Encoder
+
+FS, DT = 500.0, 1e-4
+
+
+def _name(what):
+    return f"ddmm-test-{what}-{uuid.uuid4().hex[:8]}"
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    """A noisy 500 Hz force-plate recording in mN (press, push, hold) and its offline run from the file."""
+    rng = np.random.default_rng(11)
+    n = 900
+    t = np.arange(n) / FS
+    f = np.column_stack([np.interp(t, [0, 0.6, 1.0], [0, 0, 0.8]), np.interp(t, [0, 0.6, 1.2], [0, 0, -0.5]),
+                         np.interp(t, [0, 0.1, 0.5, 2], [0, 0, 2.5, 2.5])]) + rng.normal(0, 0.01, (n, 3))
+    path = tmp_path_factory.mktemp("plate") / "plate.csv"
+    path.write_text("time,fx,fy,fz\n" + "".join(f"{a!r},{b!r},{c!r},{d!r}\n" for a, (b, c, d) in zip(t.tolist(), (f * 1e3).tolist())))
+    pop = sample_population("fingertip", rng=0).select(np.arange(0, 991, 5))
+    with pytest.warns(UserWarning, match="FA-II's band"):
+        scene = from_csv(path, units="mN")
+    offline = simulate(pop, scene, engine="direct", seed=4, quiet=True)
+    ids = offline.afferent.values[offline.spike_afferent.values]
+    steps = np.round(offline.spike_time.values / DT).astype(np.int64)
+    return pop, f * 1e3, ids, steps
+
+
+def _fake(offset=0.25, n_sites=1):
+    return ForceStream("fake", "fake-id", "host", FS, n_sites, "mN", 1, offset, inlet=None)
+
+
+class _Collect:
+    def __init__(self):
+        self.positions, self.stamps = [], []
+
+    def __call__(self, positions, stamps):
+        self.positions.append(np.asarray(positions))
+        self.stamps.append(np.asarray(stamps))
+
+    def arrays(self):
+        return (np.concatenate(self.positions or [np.empty(0, int)]),
+                np.concatenate(self.stamps or [np.empty(0)]))
+
+
+def test_check_stamps_keeps_increasing_stamps_and_measures_gaps():
+    keep, excess = check_stamps([0.001, 0.002, 0.0015, 0.002, 0.0041, 0.0051], 0.0, 1000.0)
+    assert keep.tolist() == [True, True, False, False, True, True]
+    np.testing.assert_allclose(excess, [0, 0, 0, 0, 0.0011, 0], atol=1e-12)
+    keep, excess = check_stamps([5.0, 5.0014], None, 1000.0)  # 1.4 periods: jitter, not a gap
+    assert keep.all() and not excess.any()
+
+
+@settings(max_examples=8, deadline=None)
+@given(cuts=st.lists(st.integers(1, 899), max_size=20, unique=True), jitter=st.floats(0.0, 0.45))
+def test_any_arrival_and_stamp_jitter_gives_the_offline_spikes(recording, cuts, jitter):
+    """Chunks of any size (arrival) and stamps jittered by up to 0.45 of a period change no spike and no stamp."""
+    pop, raw, ids, steps = recording
+    rng = np.random.default_rng(len(cuts))
+    stamps = 100.0 + np.arange(raw.shape[0]) / FS + rng.uniform(-0.5, 0.5, raw.shape[0]) * jitter / FS
+    stamps[0] = 100.0
+    sink = _Collect()
+    bridge = Bridge(Encoder(pop, FS, seed=4), _fake(), sink)
+    edges = [0] + sorted(cuts) + [raw.shape[0]]
+    for a, b in zip(edges[:-1], edges[1:]):
+        bridge.consume(raw[a:b], stamps[a:b])
+    positions, out = sink.arrays()
+    np.testing.assert_array_equal(pop.afferent_id[positions], ids)
+    np.testing.assert_array_equal(np.round((out - 100.25) / DT).astype(np.int64), steps)
+    assert bridge.summary.samples == raw.shape[0] and not bridge.summary.gaps and ids.size > 200
+
+
+def test_a_gap_is_reported_and_moves_later_stamps_on(recording):
+    pop, raw, ids, steps = recording
+    stamps = np.arange(raw.shape[0]) / FS
+    stamps[600:] += 0.2  # 100 samples lost in transmission
+    sink, messages = _Collect(), []
+    bridge = Bridge(Encoder(pop, FS, seed=4), _fake(offset=0.0), sink, report=messages.append)
+    bridge.consume(raw, stamps)
+    positions, out = sink.arrays()
+    np.testing.assert_array_equal(pop.afferent_id[positions], ids)  # samples taken as consecutive
+    after = steps * DT >= 600 / FS
+    np.testing.assert_array_equal(np.round((out - 0.2 * after) / DT).astype(np.int64), steps)
+    assert len(bridge.summary.gaps) == 1 and "a gap of 0.202 s" in messages[0]
+    assert bridge.summary.gaps[0][0] == pytest.approx(599 / FS)
+
+
+def test_out_of_order_and_refused_samples_are_dropped_and_reported(recording):
+    pop, raw, _, _ = recording
+    stamps = np.arange(raw.shape[0]) / FS
+    bad = raw.copy()
+    bad[300, 2] = np.nan
+    order = np.r_[np.arange(450), 200, np.arange(450, raw.shape[0])]  # sample 200 again, late
+    sink, messages = _Collect(), []
+    bridge = Bridge(Encoder(pop, FS, seed=4), _fake(offset=0.0), sink, report=messages.append)
+    bridge.consume(bad[order], stamps[order])
+    assert bridge.summary.out_of_order == 1 and bridge.summary.skipped == 1
+    assert any("at or before" in m for m in messages) and any("skipped" in m for m in messages)
+    # the same as an encoder that never saw either sample, its clock one sample on after the refused one
+    expected = _Collect()
+    enc = Encoder(pop, FS, seed=4)
+    for a, b, shift in ((0, 300, 0.0), (301, raw.shape[0], 1 / FS)):
+        out = enc.push(raw[a:b] * 1e-3)
+        expected(out.afferent, out.time + shift)
+    np.testing.assert_array_equal(sink.arrays()[0], expected.arrays()[0])
+    np.testing.assert_allclose(sink.arrays()[1], expected.arrays()[1], atol=1e-9)
+
+
+def test_bridge_refuses_an_encoder_of_another_rate_or_site_count(recording):
+    pop = recording[0]
+    with pytest.raises(ValueError, match="encoder's fs"):
+        Bridge(Encoder(pop, 1000.0), _fake(), print)
+    with pytest.raises(ValueError, match="site"):
+        Bridge(Encoder(pop, FS), _fake(n_sites=2), print)
+
+
+# ---- loopback streams --------------------------------------------------------------------------------------
+
+
+def _spike_inlet(name, timeout=5.0):
+    import pylsl
+
+    found = pylsl.resolve_byprop("name", name, 1, timeout)
+    assert found, f"spike stream {name} not found"
+    inlet = pylsl.StreamInlet(found[0], max_buflen=60)
+    info = inlet.info(timeout=timeout)
+    inlet.open_stream(timeout=timeout)
+    return inlet, info
+
+
+def _drain(inlet, until, expected=None):
+    """Pull spikes until ``until()`` and the inlet is quiet, or 20 s."""
+    ids, stamps, deadline, quiet = [], [], time.monotonic() + 20.0, 0
+    while time.monotonic() < deadline and quiet < 5:
+        samples, ts = inlet.pull_chunk(timeout=0.05, max_samples=4096, min_samples=1, as_numpy=True)
+        if len(ts):
+            ids.append(samples[:, 0].astype(np.int64))
+            stamps.append(np.asarray(ts))
+            quiet = 0
+        elif until():
+            quiet += 1
+    return np.concatenate(ids or [np.empty(0, np.int64)]), np.concatenate(stamps or [np.empty(0)])
+
+
+def test_spikes_over_lsl_equal_the_offline_run_of_the_recorded_scene(recording):
+    """A force outlet in mN -> open_force_stream -> Bridge -> SpikeOutlet -> a consumer: the file's spikes."""
+    import pylsl
+
+    pop, raw, ids, steps = recording
+    names = _name("force"), _name("spikes")
+    outlet = open_force_outlet(names[0], fs=FS, units="mN")
+    force = open_force_stream(names[0], timeout=5.0)
+    assert (force.unit, force.fs, force.n_sites) == ("mN", FS, 1)
+    encoder = Encoder(pop, force.fs, seed=4)
+    spikes = SpikeOutlet(names[1], encoder, force=force)
+    inlet, info = _spike_inlet(names[1])
+    meta = read_spike_metadata(info)
+    np.testing.assert_array_equal(meta["afferents"]["id"], pop.afferent_id[encoder.positions])
+    assert list(meta["afferents"]["type"]) == list(pop.afferent_type[encoder.positions])
+    assert meta["input"]["name"] == names[0] and meta["model"]["seed"] == "4"
+    bridge = Bridge(encoder, force, spikes.push)
+    deadline = time.monotonic() + 20.0
+    worker = threading.Thread(target=bridge.run, kwargs={"duration": raw.shape[0] / FS,
+                                                         "should_stop": lambda: time.monotonic() > deadline})
+    worker.start()
+    t0 = pylsl.local_clock()
+    rng = np.random.default_rng(1)
+    edges = np.unique(np.r_[0, rng.integers(1, raw.shape[0], 60), raw.shape[0]])
+    for a, b in zip(edges[:-1], edges[1:]):  # irregular chunks, irregular arrival
+        outlet.push_chunk(raw[a:b], (t0 + np.arange(a, b) / FS).tolist())
+        time.sleep(rng.uniform(0, 0.004))
+    got_ids, got_stamps = _drain(inlet, lambda: not worker.is_alive())
+    worker.join(5.0)
+    force.close()
+    assert bridge.summary.stopped == "duration" and bridge.summary.samples == raw.shape[0]
+    np.testing.assert_array_equal(got_ids, ids)
+    np.testing.assert_array_equal(np.round((got_stamps - t0 - force.clock_offset_s) / DT).astype(np.int64), steps)
+
+
+def test_open_force_stream_errors_name_the_problem():
+    import pylsl
+
+    missing = _name("missing")
+    start = time.monotonic()
+    with pytest.raises(ValueError, match=f"no LSL stream named '{missing}' found within 0.5 s"):
+        open_force_stream(missing, timeout=0.5)
+    assert time.monotonic() - start < 3.0
+    name = _name("six")
+    keep = open_force_outlet(name, fs=100.0, n_sites=2, units="gf")
+    with pytest.raises(ValueError, match="has 6 channels; 1 site.* need 3"):
+        open_force_stream(name, timeout=2.0)
+    with pytest.raises(ValueError, match="declares its forces in gf, not units='N'"):
+        open_force_stream(name, n_sites=2, units="N", timeout=2.0)
+    with pytest.raises(ValueError, match="disagrees"):
+        open_force_stream(name, n_sites=2, fs=1000.0, timeout=2.0)
+    assert open_force_stream(name, n_sites=2, timeout=2.0).scale[2] == pytest.approx(9.80665e-3)
+    info = pylsl.StreamInfo(_name("swapped"), "Force", 3, 100.0, pylsl.cf_float32, "swapped")
+    channels = info.desc().append_child("channels")
+    for label in ("Fz", "Fy", "Fx"):
+        channels.append_child("channel").append_child_value("label", label)
+    swapped = pylsl.StreamOutlet(info)
+    with pytest.raises(ValueError, match="channel 0 is labelled 'Fz'"):
+        open_force_stream(info.name(), timeout=2.0)
+    irregular = pylsl.StreamOutlet(pylsl.StreamInfo(_name("irr"), "Force", 3, 0.0, pylsl.cf_double64, "irr"))
+    with pytest.raises(ValueError, match="irregular rate: give its sample rate"):
+        open_force_stream(irregular.get_info().name(), timeout=2.0)
+    del keep, swapped, irregular
+
+
+def test_a_missing_extra_is_one_line_naming_the_install(monkeypatch):
+    import sys
+
+    from ddmm.population._extras import MissingExtraError
+
+    monkeypatch.setitem(sys.modules, "pylsl", None)
+    with pytest.raises(MissingExtraError, match=r'pip install "ddmm\[lsl\]"'):
+        open_force_stream("anything")
