@@ -43,7 +43,7 @@ def _ddmm_commands(page: Path) -> list:
     for code in _blocks(page, "bash"):
         for line in code.splitlines():
             for part in line.split("&&"):
-                words = shlex.split(re.split(r"\s[|<>#]|^#", part)[0].strip())
+                words = shlex.split(re.split(r"\s[|<>#&]|^#", part)[0].strip())
                 if words and Path(words[0]).name == "ddmm":
                     commands.append(words[1:])
     return commands

@@ -99,6 +99,10 @@ class ForceStream:
         one = np.array([1.0, 1.0, float(self.fz_sign)]) * UNITS[self.unit]
         return np.tile(one, self.n_sites)
 
+    def open(self, timeout: float = 5.0) -> None:
+        """Start receiving: samples pushed from now on arrive (a sender waiting for consumers starts)."""
+        self.inlet.open_stream(timeout=timeout)
+
     def close(self) -> None:
         """Close the inlet (the stream itself belongs to its sender)."""
         self.inlet.close_stream()
@@ -168,7 +172,10 @@ def _stream_rate(name: str, nominal: float, fs: float | None) -> float:
 
 def open_force_stream(name: str, *, n_sites: int = 1, fs: float | None = None, units: str | None = None,
                       fz_sign: int = 1, source_id: str | None = None, timeout: float = 5.0) -> ForceStream:
-    """Resolve a force stream by name, check it, and open an inlet on it.
+    """Resolve a force stream by name, check it, and make an inlet on it.
+
+    The inlet receives samples from its ``open()`` (`Bridge.run` opens it),
+    so a model can be set up first without the sender's samples piling up.
 
     Parameters
     ----------
@@ -220,7 +227,6 @@ def open_force_stream(name: str, *, n_sites: int = 1, fs: float | None = None, u
         declared, labels = _channel_units_labels(full)
         unit = _stream_unit(name, declared, units)
         _check_labels(name, labels)
-        inlet.open_stream(timeout=timeout)
         # Ask once now: the first correction takes a few exchanges, and a pull waiting on it would stall.
         offset = inlet.time_correction(timeout=timeout)
     except Exception:
@@ -303,7 +309,8 @@ class SpikeOutlet:
         _describe(info.desc(), encoder, force)
         self.name = name
         self._ids = encoder.population.afferent_id.astype(np.int32)
-        self._outlet = pylsl.StreamOutlet(info)
+        # An irregular stream's buffer counts hundreds of samples: 360,000 spikes for a slow consumer.
+        self._outlet = pylsl.StreamOutlet(info, max_buffered=3600)
 
     def push(self, positions, stamps) -> None:
         """Send spikes: the afferents' positions in the encoder's population and their LSL stamps (s)."""

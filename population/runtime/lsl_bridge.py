@@ -88,7 +88,7 @@ def check_stamps(stamps, last: float | None, fs: float):
     Examples
     --------
     >>> keep, excess = check_stamps([0.001, 0.002, 0.0015, 0.010], 0.0, 1000.0)
-    >>> keep.tolist(), [round(e, 6) for e in excess]
+    >>> keep.tolist(), excess.round(6).tolist()
     ([True, True, False, True], [0.0, 0.0, 0.0, 0.007])
     """
     stamps = np.asarray(stamps, dtype=float)
@@ -210,6 +210,11 @@ class Bridge:
         """
         lost = _pylsl("Bridge.run").util.LostError
         limit = None if duration is None else int(round(check_positive(duration, "duration", "s") * self.force.fs))
+        try:
+            self.force.open()
+        except lost:
+            self.summary.stopped = "end of input"
+            return self.summary
         while True:
             if limit is not None and self.summary.samples >= limit:
                 self.summary.stopped = "duration"

@@ -141,7 +141,7 @@ def _spike_inlet(name, timeout=5.0):
 
     found = pylsl.resolve_byprop("name", name, 1, timeout)
     assert found, f"spike stream {name} not found"
-    inlet = pylsl.StreamInlet(found[0], max_buflen=60)
+    inlet = pylsl.StreamInlet(found[0], max_buflen=3600)  # irregular rate: hundreds of samples
     info = inlet.info(timeout=timeout)
     inlet.open_stream(timeout=timeout)
     return inlet, info
@@ -182,6 +182,8 @@ def test_spikes_over_lsl_equal_the_offline_run_of_the_recorded_scene(recording):
     worker = threading.Thread(target=bridge.run, kwargs={"duration": raw.shape[0] / FS,
                                                          "should_stop": lambda: time.monotonic() > deadline})
     worker.start()
+    while not outlet.have_consumers() and time.monotonic() < deadline:  # the bridge opens the inlet
+        time.sleep(0.01)
     t0 = pylsl.local_clock()
     rng = np.random.default_rng(1)
     edges = np.unique(np.r_[0, rng.integers(1, raw.shape[0], 60), raw.shape[0]])

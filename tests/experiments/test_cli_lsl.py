@@ -1,0 +1,146 @@
+"""``ddmm stream --lsl-in/--lsl-out`` and ``ddmm play`` as separate processes, over loopback LSL.
+
+Each test's streams have unique names; every wait is bounded (process timeouts, resolve timeouts).
+"""
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+import uuid
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ddmm.population import birznieks, sample_population
+from ddmm.population.runtime.lsl import open_force_outlet, read_spike_metadata
+from ddmm.population.runtime.stream import Encoder
+
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "live-sensors.md"
+
+
+def _name(what):
+    return f"ddmm-cli-{what}-{uuid.uuid4().hex[:8]}"
+
+
+def _ddmm(*argv):
+    return subprocess.Popen([sys.executable, "-m", "ddmm.experiments.cli", *argv], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env={**os.environ, "DDMM_PROGRESS": "0"})
+
+
+def _inlet(name, timeout):
+    import pylsl
+
+    found = pylsl.resolve_byprop("name", name, 1, timeout)
+    assert found, f"stream {name} did not appear within {timeout} s"
+    inlet = pylsl.StreamInlet(found[0], max_buflen=3600)  # irregular rate: hundreds of samples
+    info = inlet.info(timeout=5.0)
+    inlet.open_stream(timeout=5.0)
+    return inlet, info
+
+
+def test_stream_over_lsl_equals_the_in_process_encoder():
+    """A force outlet here, ``ddmm stream --lsl-in --lsl-out`` in another process, the spikes read back here."""
+    import pylsl
+
+    force, spikes = _name("force"), _name("spikes")
+    scene = birznieks(45.0)
+    raw = np.column_stack([scene.fx, scene.fy, scene.fz])[::2] * 1e3  # 500 Hz, in mN
+    outlet = open_force_outlet(force, fs=500.0, units="mN")
+    proc = _ddmm("stream", "--lsl-in", force, "--lsl-out", spikes, "--seed", "3", "--types", "SAI,RAI,SAII",
+                 "--duration", f"{raw.shape[0] / 500.0}", "--resolve-timeout", "60")
+    try:
+        inlet, info = _inlet(spikes, 90.0)  # the first run in a fresh environment compiles numba kernels
+        t0 = pylsl.local_clock()
+        for a in range(0, raw.shape[0], 7):
+            outlet.push_chunk(raw[a:a + 7], (t0 + np.arange(a, min(a + 7, raw.shape[0])) / 500.0).tolist())
+            time.sleep(0.002)
+        ids, stamps = [], []
+        deadline = time.monotonic() + 60.0
+        while time.monotonic() < deadline and (proc.poll() is None or len(ids) == 0 or chunk_len):
+            samples, ts = inlet.pull_chunk(timeout=0.2, max_samples=4096, min_samples=1, as_numpy=True)
+            chunk_len = len(ts)
+            if chunk_len:
+                ids.append(samples[:, 0].astype(np.int64))
+                stamps.append(np.asarray(ts))
+        out, err = proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+    assert proc.returncode == 0, err
+    assert f"{raw.shape[0]:,} samples in" in err and "(duration)" in err
+    meta = read_spike_metadata(info)
+    offset = float(meta["input"]["clock_offset_s"])
+    pop = sample_population("fingertip", rng=3)
+    expected = Encoder(pop, 500.0, seed=3, types=("SAI", "RAI", "SAII")).push(raw * 1e-3)
+    got = np.concatenate(ids)
+    np.testing.assert_array_equal(got, pop.afferent_id[expected.afferent])
+    steps = np.round((np.concatenate(stamps) - t0 - offset) / 1e-4).astype(np.int64)
+    np.testing.assert_array_equal(steps, np.round(expected.time / 1e-4).astype(np.int64))
+    assert set(meta["afferents"]["type"]) == {"SAI", "RAI", "SAII"} and got.size > 100
+
+
+def test_a_signal_stops_the_stream_cleanly():
+    force = _name("quiet")
+    outlet = open_force_outlet(force, fs=1000.0)
+    proc = _ddmm("stream", "--lsl-in", force, "--resolve-timeout", "60")
+    try:
+        deadline = time.monotonic() + 90.0
+        while not outlet.have_consumers() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        time.sleep(2.0)  # past the encoder's set-up
+        outlet.push_chunk(np.tile([0.0, 0.0, 1.0], (50, 1)))
+        time.sleep(0.5)
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+    assert proc.returncode == 0, err
+    assert re.search(r"stream ended: 50 samples in, [\d,]+ spikes out.*\(stopped\)", err), err
+    assert "Traceback" not in err
+
+
+def test_the_docs_two_process_example_runs():
+    """The bash block of docs/live-sensors.md marked 'two processes', run as written (with unique names)."""
+    block = re.search(r"<!-- two processes -->\n```bash\n(.*?)```", DOCS.read_text(), re.S).group(1)
+    names = {"glove": _name("glove")}
+    script = re.sub(r"\bglove\b", names["glove"], block)
+    done = subprocess.run(["bash", "-c", script], capture_output=True, text=True, timeout=240,
+                          env={**os.environ, "DDMM_PROGRESS": "0", "PATH": f"{Path(sys.executable).parent}:"
+                                                                           f"{os.environ['PATH']}"})
+    assert done.returncode == 0, done.stderr
+    assert re.search(r"stream ended: 50 samples in, [\d,]+ spikes out, 0 gap\(s\).*\(end of input\)", done.stderr)
+    rows = [line.split(",") for line in done.stdout.strip().splitlines()]
+    assert len(rows) > 100 and {r[2] for r in rows} <= {"SAI", "RAI", "SAII"}
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--lsl-in", "ddmm-cli-nothere", "--resolve-timeout", "1"], "no LSL stream named 'ddmm-cli-nothere' found "
+                                                                  "within 1 s"),
+    (["--lsl-in", "X", "--sites", "fingertips", "--resolve-timeout", "1"], "no LSL stream named 'X'"),
+    (["--lsl-source-id", "abc", "--fs", "100"], "--lsl-source-id goes with --lsl-in"),
+    ([], "--fs is required when the input is standard input"),
+])
+def test_stream_errors_are_one_line(argv, message, capsys):
+    from ddmm.experiments.cli import main
+
+    start = time.monotonic()
+    assert main(["stream", *argv]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert time.monotonic() - start < 10.0
+
+
+def test_a_stream_of_the_wrong_width_and_a_missing_extra(capsys, monkeypatch):
+    from ddmm.experiments.cli import main
+
+    name = _name("wide")
+    keep = open_force_outlet(name, fs=100.0, n_sites=2)
+    assert main(["stream", "--lsl-in", name, "--resolve-timeout", "5"]) == 2
+    assert "has 6 channels; 1 site(s) need 3" in capsys.readouterr().err
+    del keep
+    monkeypatch.setitem(sys.modules, "pylsl", None)
+    assert main(["stream", "--lsl-in", name, "--resolve-timeout", "1"]) == 2
+    assert 'open_force_stream needs pylsl: pip install "ddmm[lsl]"' in capsys.readouterr().err
