@@ -18,7 +18,7 @@ import sys
 import tempfile
 import time
 
-from ddmm.experiments.bench_cases import CASES, DT, EXTRA_CASES, SCALING, SITE_BASELINES
+from ddmm.experiments.bench_cases import CASES, DT, EXTRA_CASES, LSL_CASES, SCALING, SITE_BASELINES
 
 __all__ = ["run_bench", "register"]
 
@@ -59,8 +59,9 @@ def _cold_start(engine: str) -> tuple[dict, float]:
 def run_bench(cases=None) -> dict:
     """All cases, each in a fresh process, plus the cold starts (``cases=["scaling"]``: the scaling table)."""
     names = list(CASES) + list(EXTRA_CASES) if cases is None else list(cases)
-    if names == ["scaling"]:
-        return {"cases": [_subprocess_case(n) for n in SCALING], "ratios": {}, "one_time": {}}
+    if names in (["scaling"], ["lsl"]):
+        return {"cases": [_subprocess_case(n) for n in (SCALING if names == ["scaling"] else LSL_CASES)],
+                "ratios": {}, "one_time": {}}
     results = [_subprocess_case(n) for n in names]
     one_time = {}
     for engine in ("direct", "brian2") if cases is None else ():
@@ -91,6 +92,12 @@ def _table(result: dict) -> str:
         if "median_ms" in c:
             notes.append(f"per 1 ms chunk, real-time paced: median {c['median_ms']:.3f} ms, p99 {c['p99_ms']:.3f} ms; "
                          f"back to back: {c['unpaced_median_ms']:.3f} / {c['unpaced_p99_ms']:.3f} ms")
+        if "lsl_latency" in c:
+            lsl, own = c["lsl_latency"], c["in_process_spiking"]
+            notes.append(f"sample-to-spike over LSL: median {lsl.get('median_ms', float('nan')):.3f} ms, p99 "
+                         f"{lsl.get('p99_ms', float('nan')):.3f} ms, worst {lsl.get('max_ms', float('nan')):.2f} ms; "
+                         f"in-process push of the same samples: {own['median_ms']:.3f} / {own['p99_ms']:.3f} / "
+                         f"{own['max_ms']:.2f} ms ({c['spikes_over_lsl']:,} spikes)")
         if "us_per_afferent_second" in c:
             notes.append(f"{c['us_per_afferent_second']:.2f} us per afferent-second")
         if "peak_rss_per_worker_mb" in c:
@@ -106,17 +113,17 @@ def register(sub) -> None:
     p = sub.add_parser("bench", help="speed and memory of the whole pipeline (fresh process per case)")
     p.add_argument("--json", action="store_true")
     p.add_argument("--out", metavar="DIR", help="write bench.json (and scaling.png for --cases scaling) here")
-    p.add_argument("--cases", default=None, help="'scaling' (afferents x seconds) or a comma-separated subset of: "
-                   + ", ".join([*CASES, *EXTRA_CASES]))
+    p.add_argument("--cases", default=None, help="'scaling' (afferents x seconds), 'lsl' (latency over Lab Streaming "
+                   "Layer, extra ddmm[lsl]) or a comma-separated subset of: " + ", ".join([*CASES, *EXTRA_CASES]))
     p.set_defaults(func=_run)
 
 
 def _run(args) -> int:
     cases = None if args.cases is None else [c.strip() for c in args.cases.split(",")]
-    allowed = [*CASES, *EXTRA_CASES, *SCALING]
+    allowed = [*CASES, *EXTRA_CASES, *SCALING, *LSL_CASES]
     for c in cases or []:
-        if c not in allowed and cases != ["scaling"]:
-            raise ValueError(f"--cases: {c!r} is unknown; allowed: scaling, {', '.join(allowed)}")
+        if c not in allowed and cases not in (["scaling"], ["lsl"]):
+            raise ValueError(f"--cases: {c!r} is unknown; allowed: scaling, lsl, {', '.join(allowed)}")
     out_dir = None
     if args.out:
         from ddmm.experiments.io import ensure_out_dir

@@ -20,7 +20,7 @@ import json
 import resource
 import time
 
-__all__ = ["CASES", "EXTRA_CASES", "SCALING", "SITE_BASELINES", "run_case", "run_extra"]
+__all__ = ["CASES", "EXTRA_CASES", "LSL_CASES", "SCALING", "SITE_BASELINES", "run_case", "run_extra"]
 
 #: name -> (population, engine, simulated seconds, warm-up?)
 CASES = {
@@ -34,6 +34,8 @@ CASES = {
 #: workers, and the streaming encoder's per-chunk latency (raw forces, and through the conditioning stage).
 EXTRA_CASES = ("scale_100k_inprocess", "scale_100k_2workers", "stream_fingertip", "stream_hand",
                "stream_fingertip_conditioned", "hand_5sites_1s_direct", "fingertip_16taxels_1s_direct")
+#: ``--cases lsl``: sample-to-spike latency over Lab Streaming Layer beside the in-process push (extra ddmm[lsl]).
+LSL_CASES = ("lsl_fingertip", "lsl_hand")
 #: ``--cases scaling``: afferents x simulated seconds, each in a fresh process.
 SCALING = tuple(f"scaling_{n}k_{t}s" for n in (1, 10, 100) for t in (1, 10))
 #: Multi-site cases and the one-site case each is compared with (same population, same run).
@@ -258,6 +260,9 @@ def _scaling_case(name: str) -> dict:
 
 def run_extra(name: str) -> dict:
     """Run one of `EXTRA_CASES` or `SCALING` in this process."""
+    if name in LSL_CASES:
+        from ddmm.experiments.bench_lsl import run_lsl_case
+        return run_lsl_case(name)
     if name in SCALING:
         return _scaling_case(name)
     if name in SITE_BASELINES:
@@ -279,12 +284,12 @@ def _cold_main(engine: str, out: str) -> None:
 
 if __name__ == "__main__":  # pragma: no cover - the per-case subprocess entries
     parser = argparse.ArgumentParser()
-    parser.add_argument("--case", choices=sorted([*CASES, *EXTRA_CASES, *SCALING]))
+    parser.add_argument("--case", choices=sorted([*CASES, *EXTRA_CASES, *SCALING, *LSL_CASES]))
     parser.add_argument("--cold", nargs=2, metavar=("ENGINE", "OUT"))
     cli_args = parser.parse_args()
     if cli_args.cold:
         _cold_main(*cli_args.cold)
-    elif cli_args.case in EXTRA_CASES or cli_args.case in SCALING:
+    elif cli_args.case in EXTRA_CASES or cli_args.case in SCALING or cli_args.case in LSL_CASES:
         print(json.dumps(run_extra(cli_args.case)))
     else:
         print(json.dumps(run_case(cli_args.case)))

@@ -221,8 +221,7 @@ def _run_lsl(args, sites) -> int:
           f"{force.fs:g} Hz, {force.unit})", file=sys.stderr, flush=True)
     try:
         encoder = _encoder(args, force.fs, sites)
-        encoder.push(np.zeros((1, 3) if sites is None else (1, len(sites), 3)))  # load the kernels now, not on
-        encoder.reset()  # the first sample (the inlet opens after this: nothing piles up meanwhile)
+        encoder.warm_up()  # before the inlet opens: nothing piles up meanwhile
         sink, outlet = _spike_sink(args, encoder, force)
         bridge = Bridge(encoder, force, sink, report=lambda m: print(f"ddmm: {m}", file=sys.stderr, flush=True))
         with _stop_on_signals() as should_stop:

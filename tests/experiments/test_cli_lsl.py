@@ -144,3 +144,12 @@ def test_a_stream_of_the_wrong_width_and_a_missing_extra(capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "pylsl", None)
     assert main(["stream", "--lsl-in", name, "--resolve-timeout", "1"]) == 2
     assert 'open_force_stream needs pylsl: pip install "ddmm[lsl]"' in capsys.readouterr().err
+
+
+def test_the_bench_latency_is_per_sample_until_its_last_spike():
+    from ddmm.experiments.bench_lsl import _latencies
+
+    pushed = 10.0 + np.arange(5) / 1000.0 + 0.0002  # pushed 0.2 ms after each due time
+    anchor = 10.0  # due time of sample 0 on this host's clock
+    arrivals = [(10.0009, np.array([10.00005, 10.00095])), (10.0035, np.array([10.0001, 10.0031]))]
+    np.testing.assert_allclose(_latencies(pushed, anchor, arrivals), [0.0035 - 0.0002, 0.0035 - 0.0032])

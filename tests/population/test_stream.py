@@ -165,3 +165,14 @@ def test_cli_stream_at_100_hz_with_types_and_a_gap(capsys, monkeypatch):
     rows = [r.split(",") for r in out.strip().splitlines()]
     assert len(rows) > 50 and {r[2] for r in rows} == {"SAI", "RAI"}
     assert "line 102: a gap of 0.21 s at t = 0.99 s" in err and "skipped" not in err
+
+
+def test_warm_up_changes_no_spike_and_refuses_once_samples_were_pushed(setup):
+    pop, forces, offline = setup
+    enc = Encoder(pop, 1000.0, seed=3, conditioning=None)
+    enc.warm_up()
+    out = enc.push(forces)
+    np.testing.assert_array_equal(out.afferent, offline["direct"].spike_afferent.values)
+    np.testing.assert_array_equal(out.time, offline["direct"].spike_time.values)
+    with pytest.raises(ValueError, match="warm_up\\(\\) goes before the first push; 3000 samples"):
+        enc.warm_up()
