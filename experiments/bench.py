@@ -92,6 +92,10 @@ def _table(result: dict) -> str:
         if "median_ms" in c:
             notes.append(f"per 1 ms chunk, real-time paced: median {c['median_ms']:.3f} ms, p99 {c['p99_ms']:.3f} ms; "
                          f"back to back: {c['unpaced_median_ms']:.3f} / {c['unpaced_p99_ms']:.3f} ms")
+        if "electrodes" in c:
+            notes.append(f"per 1 ms chunk with {c['electrodes']} electrodes: median {c['stimulation_median_ms']:.3f} "
+                         f"ms, p99 {c['stimulation_p99_ms']:.3f} ms; the encoder alone {c['encoder_median_ms']:.3f} / "
+                         f"{c['encoder_p99_ms']:.3f} ms")
         if "lsl_latency" in c:
             lsl, own = c["lsl_latency"], c["in_process_spiking"]
             notes.append(f"sample-to-spike over LSL: median {lsl.get('median_ms', float('nan')):.3f} ms, p99 "

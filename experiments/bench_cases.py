@@ -33,7 +33,8 @@ CASES = {
 #: Cases beyond one process: 100,000 afferents in-process and on 2 local Dask
 #: workers, and the streaming encoder's per-chunk latency (raw forces, and through the conditioning stage).
 EXTRA_CASES = ("scale_100k_inprocess", "scale_100k_2workers", "stream_fingertip", "stream_hand",
-               "stream_fingertip_conditioned", "hand_5sites_1s_direct", "fingertip_16taxels_1s_direct")
+               "stream_fingertip_conditioned", "hand_5sites_1s_direct", "fingertip_16taxels_1s_direct",
+               "stimulate_hand_16")
 #: ``--cases lsl``: sample-to-spike latency over Lab Streaming Layer beside the in-process push (extra ddmm[lsl]).
 LSL_CASES = ("lsl_fingertip", "lsl_hand")
 #: ``--cases scaling``: afferents x simulated seconds, each in a fresh process.
@@ -258,8 +259,46 @@ def _scaling_case(name: str) -> dict:
             "spikes": int(ds.sizes["spike"])}
 
 
+def _stimulate_case(seconds: float = 2.0) -> dict:
+    """The stimulation encoder's cost per 1 ms chunk: the hand, five digit-tip sites, 16 region electrodes
+    (biomimetic rule), beside the same encoder's push alone on the same samples, paced in real time."""
+    import numpy as np
+
+    from ddmm.population import sample_population
+    from ddmm.population.anatomy.hand_map import region_names
+    from ddmm.population.runtime.stream import Encoder
+    from ddmm.population.stimulation import Electrode, StimulationEncoder
+
+    pop, scene = sample_population("hand", rng=0), _site_scene("hand", seconds)
+    table = [Electrode(r, 20.0, 80.0, 200.0, 300.0, 20.0, region=r) for r in region_names()[:16]]
+    laps = {}
+    for label in ("encoder", "stimulation"):
+        enc = Encoder(pop, 1000.0, dt=DT, seed=0, sites=scene.sites, conditioning=None)
+        unit = enc if label == "encoder" else StimulationEncoder(enc, table)
+        unit.warm_up()
+        f, out = scene.site_forces, np.empty(scene.n_samples)
+        t0 = time.perf_counter()
+        for k in range(scene.n_samples):
+            wait = t0 + k * 1e-3 - time.perf_counter()
+            if wait > 0:
+                time.sleep(wait)
+            start = time.perf_counter()
+            unit.push(f[k:k + 1])
+            out[k] = time.perf_counter() - start
+        laps[label] = out * 1e3
+    stats = {f"{k}_{s}_ms": round(float(fn(v)), 4) for k, v in laps.items()
+             for s, fn in (("median", np.median), ("p99", lambda x: np.percentile(x, 99)))}
+    return {"name": "stimulate_hand_16", "engine": "direct", "n_afferents": len(pop), "sim_s": seconds,
+            "dt_ms": DT * 1e3, "wall_s": round(float(laps["stimulation"].sum()) / 1e3, 3),
+            "afferent_s_per_wall_s": round(len(pop) * seconds / (laps["stimulation"].sum() / 1e3), 1),
+            "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
+            "electrodes": len(table), **stats}
+
+
 def run_extra(name: str) -> dict:
     """Run one of `EXTRA_CASES` or `SCALING` in this process."""
+    if name == "stimulate_hand_16":
+        return _stimulate_case()
     if name in LSL_CASES:
         from ddmm.experiments.bench_lsl import run_lsl_case
         return run_lsl_case(name)

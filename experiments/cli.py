@@ -54,6 +54,7 @@ def build_parser() -> argparse.ArgumentParser:
         cmd_physiology,
         cmd_population,
         cmd_reproduce,
+        cmd_stimulate,
         cmd_stream,
     )
 
@@ -66,8 +67,8 @@ def build_parser() -> argparse.ArgumentParser:
                         help="show the full traceback of an unexpected error (also DDMM_DEBUG=1)")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                 parser_class=_Parser)
-    for module in (cmd_reproduce, cmd_population, cmd_biology, cmd_physiology, cmd_accuracy, cmd_stream, cmd_export,
-                   bench):
+    for module in (cmd_reproduce, cmd_population, cmd_biology, cmd_physiology, cmd_accuracy, cmd_stream,
+                   cmd_stimulate, cmd_export, bench):
         module.register(sub)
     return parser
 

@@ -11,10 +11,13 @@ def register(sub) -> None:
     """Add ``ddmm export``."""
     p = sub.add_parser("export", help="write a dataset (.nc) as an NWB file (needs the [nwb] extra)",
                        description="Export a dataset of 'ddmm simulate' to NWB: afferents as units, (condition, "
-                                   "trial) pairs as trials on one clock, the forces as stimulus "
-                                   "(layout: ddmm.population.io.nwb).")
+                                   "trial) pairs as trials on one clock, the forces as stimulus, optionally the "
+                                   "stimulation pulses (layout: ddmm.population.io.nwb).")
     p.add_argument("file", metavar="FILE.nc", help="dataset written by 'ddmm simulate'")
     p.add_argument("--nwb", required=True, metavar="OUT.nwb", help="NWB file to write (replaced atomically)")
+    p.add_argument("--pulses", default=None, metavar="PULSES.nc",
+                   help="stimulation pulses of the same run (ddmm.population.stimulation.save_pulses), written as "
+                        "intervals 'stimulation_pulses' with the electrode table")
     p.set_defaults(func=run_export)
 
 
@@ -23,9 +26,16 @@ def run_export(args) -> int:
 
     out = check_out_file(args.nwb, ".nwb", "--nwb")
     ds = load_dataset(args.file)
-    to_nwb(ds, out)
+    pulses = None
+    if args.pulses is not None:
+        from ddmm.population.stimulation import load_pulses
+
+        pulses = load_pulses(args.pulses)
+    to_nwb(ds, out, pulses=pulses)
     forces = ", stimulus fingertip_force (N)" if "fx" in ds else ""
+    stimulation = "" if pulses is None else \
+        f", {pulses.sizes['pulse']} stimulation pulses on {pulses.sizes['electrode']} electrode(s)"
     print(f"wrote {out} ({ds.sizes['afferent']} units, {ds.sizes['condition'] * ds.sizes['trial']} trials "
           f"= {ds.sizes['condition']} condition(s) x {ds.sizes['trial']} trial(s), {ds.sizes['spike']} spikes"
-          f"{forces})")
+          f"{forces}{stimulation})")
     return 0

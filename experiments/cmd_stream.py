@@ -59,6 +59,11 @@ def register(sub) -> None:
     g.add_argument("--lsl-out", default=None, metavar="NAME", help="publish spikes as an LSL stream of this name")
     g.add_argument("--resolve-timeout", type=float, default=5.0, metavar="S",
                    help="seconds to wait for the input stream (default 5)")
+    g.add_argument("--electrodes", default=None, metavar="E.csv|E.toml",
+                   help="an electrode table: stimulation pulses go out on --lsl-pulses (docs/stimulation.md)")
+    g.add_argument("--rule", default="biomimetic", choices=("biomimetic", "linear-amplitude", "linear-frequency"),
+                   help="the stimulation encoding rule (with --electrodes)")
+    g.add_argument("--lsl-pulses", default=None, metavar="NAME", help="publish the pulses as an LSL stream")
     add_recording_options(p, stream=True)
     p.set_defaults(func=run)
     _register_play(sub)
@@ -74,8 +79,9 @@ def _register_play(sub) -> None:
     p.add_argument("--noise", type=float, default=0.0, metavar="N", help="white sensor noise SD in newtons")
     p.add_argument("--seed", type=seed_arg, default=0)
     p.add_argument("--repeat", type=int, default=1, help="times to play the scene (default 1)")
-    p.add_argument("--wait", type=float, default=10.0, metavar="S",
-                   help="seconds to wait for a consumer before playing, and after, for it to catch up")
+    p.add_argument("--wait", type=float, default=120.0, metavar="S",
+                   help="seconds to wait for a consumer before playing (default 120: a first run compiles the "
+                        "model's kernels before it connects); after playing it waits up to 1 s for it to catch up")
     p.set_defaults(func=run_play)
 
 
@@ -183,6 +189,8 @@ def run(args) -> int:
         raise ValueError(f"--duration must be > 0 s, got {args.duration:g}")
     if args.lsl_in is None and (args.lsl_source_id is not None):
         raise ValueError("--lsl-source-id goes with --lsl-in")
+    if (args.electrodes is None) != (args.lsl_pulses is None) or (args.electrodes and args.lsl_in is None):
+        raise ValueError("--electrodes and --lsl-pulses go together, with --lsl-in")
     sites = _sites(args.sites)
     if args.lsl_in is not None:
         return _run_lsl(args, sites)
@@ -210,6 +218,20 @@ def _spike_sink(args, encoder, force):
     return outlet.push, outlet
 
 
+def _stimulator(args, encoder):
+    """The stimulation encoder and its pulse outlet (``--electrodes``), or (None, None)."""
+    if args.electrodes is None:
+        return None, None
+    from ddmm.population.runtime.lsl import PulseOutlet
+    from ddmm.population.stimulation import StimulationEncoder, read_electrodes
+
+    stimulator = StimulationEncoder(encoder, read_electrodes(args.electrodes), args.rule)
+    outlet = PulseOutlet(args.lsl_pulses, stimulator)
+    print(f"ddmm: publishing {args.rule} pulses of {len(stimulator.table)} electrode(s) on LSL stream "
+          f"{args.lsl_pulses!r} (type StimulationPulses, source id {outlet.source_id})", file=sys.stderr, flush=True)
+    return stimulator, outlet
+
+
 def _run_lsl(args, sites) -> int:
     from ddmm.population.runtime.lsl import open_force_stream
     from ddmm.population.runtime.lsl_bridge import Bridge
@@ -221,16 +243,22 @@ def _run_lsl(args, sites) -> int:
           f"{force.fs:g} Hz, {force.unit})", file=sys.stderr, flush=True)
     try:
         encoder = _encoder(args, force.fs, sites)
-        encoder.warm_up()  # before the inlet opens: nothing piles up meanwhile
+        stimulator, pulses = _stimulator(args, encoder)
+        (encoder if stimulator is None else stimulator).warm_up()  # before the inlet opens: nothing piles up
         sink, outlet = _spike_sink(args, encoder, force)
-        bridge = Bridge(encoder, force, sink, report=lambda m: print(f"ddmm: {m}", file=sys.stderr, flush=True))
+        bridge = Bridge(encoder, force, sink, report=lambda m: print(f"ddmm: {m}", file=sys.stderr, flush=True),
+                        stimulator=stimulator, pulse_sink=None if pulses is None else pulses.push)
         with _stop_on_signals() as should_stop:
             summary = bridge.run(duration=args.duration, should_stop=should_stop)
     finally:
         force.close()
-    if outlet is not None:
-        outlet.close()
+    for stream_out in (outlet, pulses):
+        if stream_out is not None:
+            stream_out.close()
     print(f"ddmm: stream ended: {summary.describe()}", file=sys.stderr, flush=True)
+    if summary.samples == 0 and summary.stopped == "end of input":
+        print("ddmm: the sender closed its stream before a sample reached us (it must wait for its consumer: "
+              "LSL drops what an inlet has not pulled)", file=sys.stderr, flush=True)
     return 0
 
 
@@ -254,6 +282,8 @@ def run_play(args) -> int:
     forces += np.random.default_rng(args.seed).normal(0.0, args.noise, forces.shape)
     outlet = open_force_outlet(args.lsl_out, fs=args.fs, units=args.units)
     deadline = time.monotonic() + args.wait
+    print(f"ddmm: waiting up to {args.wait:g} s for a consumer of LSL stream {args.lsl_out!r}", file=sys.stderr,
+          flush=True)
     while not outlet.have_consumers() and time.monotonic() < deadline:
         time.sleep(0.01)
     print(f"ddmm: playing {scene.name} ({forces.shape[0] / args.fs:g} s at {args.fs:g} Hz, {args.units}) on LSL "

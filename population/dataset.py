@@ -9,7 +9,9 @@ Schema (names are fixed):
   ``y_mm``, ``noise_sigma``, ``noise_cv``, ``region`` (hand-map region, ``""``
   when unknown) and ``frame_deg`` (deg, local digit frame to hand frame); on ``condition``: ``condition`` (scene name),
   ``duration`` (s), ``theta_r`` (deg) with ``has_theta_r`` (1 when the scene
-  has one nominal shear direction); ``time`` (s); ``stage`` (labels of the
+  has one nominal shear direction), and when a scene has a contact
+  ``contact_x_mm``, ``contact_y_mm``, ``contact_radius_mm`` (NaN for a scene
+  without); ``time`` (s); ``stage`` (labels of the
   scenes' phases, with ``stage_start``/``stage_end(condition, stage)`` in s);
 * data vars ``spike_count(condition, trial, afferent)``; the events
   ``spike_time`` (s), ``spike_afferent`` (position on ``afferent``),
@@ -39,7 +41,7 @@ from ddmm.models.attenuation import F_TH
 from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.models.neuron import NEURON_PARAMS, V_PEAK
 from ddmm.population.anatomy.receptive_fields import RF_SIGMA_MM, RF_SUPPORT
-from ddmm.population.io._files import atomic_write, writable_parent
+from ddmm.population.io._files import read_netcdf, write_netcdf
 
 __all__ = ["build_dataset", "save_dataset", "load_dataset", "binned_counts", "binned_rates", "psth",
            "describe_dataset"]
@@ -122,7 +124,18 @@ def _condition_coords(scenes) -> dict:
         "theta_r": xr.Variable("condition", np.array(theta), {"units": "deg"}),
         "has_theta_r": xr.Variable("condition", np.array([s.theta_r is not None for s in scenes], np.int8),
                                    {"units": "1"}),
+        **_contact_coords(scenes),
     }
+
+
+def _contact_coords(scenes) -> dict:
+    """``contact_x_mm``, ``contact_y_mm``, ``contact_radius_mm`` per condition when a scene has a contact (NaN: none)."""
+    if all(getattr(s, "contact", None) is None for s in scenes):
+        return {}
+    values = np.array([[np.nan] * 3 if s.contact is None else [s.contact.x_mm, s.contact.y_mm, s.contact.radius_mm]
+                       for s in scenes], dtype=float)
+    return {f"contact_{name}": xr.Variable("condition", values[:, i], {"units": "mm"})
+            for i, name in enumerate(("x_mm", "y_mm", "radius_mm"))}
 
 
 def _events(plan, spikes, n_conditions: int):
@@ -258,23 +271,12 @@ def save_dataset(ds: xr.Dataset, path) -> Path:
     ValueError
         If the directory does not exist or cannot be written.
     """
-    path = Path(path)
-    directory, writable = writable_parent(path)
-    if not writable:
-        raise ValueError(f"cannot write {str(path)!r}: {str(directory)!r} is not a writable directory")
-    return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+    return write_netcdf(ds, path)
 
 
 def load_dataset(path) -> xr.Dataset:
     """Read a dataset written by `save_dataset` fully into memory."""
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"dataset file {str(path)!r} does not exist")
-    try:
-        ds = xr.load_dataset(path, engine="h5netcdf")
-    except (OSError, ValueError) as exc:
-        reason = " ".join(str(exc).split())
-        raise ValueError(f"dataset file {str(path)!r} is not a netCDF-4 file ddmm can read ({reason})") from None
+    ds = read_netcdf(path, "dataset file")
     if "afferent" not in ds.dims or "ddmm_version" not in ds.attrs:
         array = ds.attrs.get("layout") == "ddmm sensor array"
         raise ValueError(f"dataset file {str(path)!r} is not a ddmm simulation dataset (no afferent dimension"

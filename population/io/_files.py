@@ -8,7 +8,7 @@ import socket
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_write", "writable_parent", "sweep_stale_parts"]
+__all__ = ["atomic_write", "writable_parent", "sweep_stale_parts", "write_netcdf", "read_netcdf"]
 
 
 def _umask_mode() -> int:
@@ -99,3 +99,26 @@ def atomic_write(path, write, *, suffix: str = ".part") -> Path:
     except OSError:  # some file systems cannot sync a directory; the rename itself has happened
         pass
     return path
+
+
+def write_netcdf(ds, path) -> Path:
+    """Write an xarray Dataset to netCDF-4 (HDF5) atomically; a directory that cannot be written is a ValueError."""
+    path = Path(path)
+    directory, writable = writable_parent(path)
+    if not writable:
+        raise ValueError(f"cannot write {str(path)!r}: {str(directory)!r} is not a writable directory")
+    return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+
+
+def read_netcdf(path, what: str):
+    """Read a netCDF-4 file fully into memory; a missing or unreadable file is a ValueError naming ``what``."""
+    import xarray as xr
+
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"{what} {str(path)!r} does not exist")
+    try:
+        return xr.load_dataset(path, engine="h5netcdf")
+    except (OSError, ValueError) as exc:
+        reason = " ".join(str(exc).split())
+        raise ValueError(f"{what} {str(path)!r} is not a netCDF-4 file ddmm can read ({reason})") from None

@@ -30,6 +30,26 @@ Layout (core NWB types only, no extension):
   ``rate = fs`` from 0 s, each trial's condition force at its trial's place
   on the session clock; multi-site scenes add ``stimulus["site_force"]``
   (n, n_sites, 3), whose description lists the sites in order.
+* **Stimulation pulses**, when ``pulses`` is given (a pulses Dataset of
+  `ddmm.population.stimulation.stimulation_pulses` for the same run):
+  ``nwbfile.intervals["stimulation_pulses"]``, a TimeIntervals table with one
+  row per pulse in the Dataset's order, ``start_time`` = the start of the
+  cathodic phase on the session clock (``trials.start_time[k] + pulse_time``,
+  as for spikes), ``stop_time`` = ``start_time + (2 phase_width_us +
+  interphase_us) * 1e-6`` (the whole biphasic pulse), and columns
+  ``electrode`` (id), ``amplitude_ua`` (µA), ``phase_width_us`` and
+  ``interphase_us`` (µs), ``charge_nc`` (nC per phase), ``condition`` (scene
+  name, as in the trials table) and ``trial`` (trial index within the
+  condition, as in the trials table).  Its description names the waveform,
+  the rule and the rule's settings.  The electrode table is
+  ``nwbfile.processing["stimulation"]["stimulation_electrodes"]``, a
+  DynamicTable with one row per electrode: ``electrode`` (id), the projected
+  field ``x_mm``, ``y_mm``, ``radius_mm`` (mm; NaN for a region field) and
+  ``region`` (empty for a disc), and the limits ``amplitude_min_ua``,
+  ``amplitude_max_ua`` (µA), ``phase_width_us``, ``interphase_us`` (µs),
+  ``max_rate_hz`` (Hz) and ``charge_limit_nc`` (nC per phase).  A run without
+  pulses writes the electrode table and no pulse table (NWB best practice:
+  no empty tables).
 * **Metadata.** ``notes`` is the JSON of the Dataset's attrs (every model
   constant, engine, dt, method, seed, ddmm version); ``data_collection`` says
   in words how it was simulated; ``was_generated_by`` names ddmm and pynwb
@@ -54,7 +74,7 @@ __all__ = ["to_nwb"]
 
 
 def to_nwb(dataset, path, *, session_description: str | None = None, identifier: str | None = None,
-           session_start_time: _dt.datetime | None = None) -> Path:
+           session_start_time: _dt.datetime | None = None, pulses=None) -> Path:
     """Write a simulation Dataset to an NWB file, atomically (layout in the module docstring).
 
     Parameters
@@ -70,6 +90,11 @@ def to_nwb(dataset, path, *, session_description: str | None = None, identifier:
         The file's unique identifier.  Default: a random UUID.
     session_start_time : datetime.datetime, optional
         Timezone-aware origin of the session clock.  Default: now (UTC).
+    pulses : xarray.Dataset, optional
+        Stimulation pulses of this run (`ddmm.population.stimulation.stimulation_pulses`
+        or `load_pulses`), written as ``intervals["stimulation_pulses"]`` with the
+        electrode table (module docstring).  Its conditions, trial count and
+        sample rate must be the dataset's.
 
     Returns
     -------
@@ -79,7 +104,8 @@ def to_nwb(dataset, path, *, session_description: str | None = None, identifier:
     Raises
     ------
     TypeError, ValueError
-        On a bad argument (the message names it); ImportError without pynwb.
+        On a bad argument (the message names it), e.g. ``pulses`` of another
+        run; ImportError without pynwb.
 
     Examples
     --------
@@ -90,6 +116,15 @@ def to_nwb(dataset, path, *, session_description: str | None = None, identifier:
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     print(to_nwb(ds, pathlib.Path(tmp) / "run.nwb").name)
     run.nwb
+
+    With the stimulation pulses of the same run:
+
+    >>> from ddmm.population.stimulation import Electrode, stimulation_pulses
+    >>> table = [Electrode("E1", 20.0, 80.0, 200.0, 300.0, 20.0, x_mm=0.0, y_mm=0.0, radius_mm=10.0)]
+    >>> pulses = stimulation_pulses(ds, table)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     print(to_nwb(ds, pathlib.Path(tmp) / "run.nwb", pulses=pulses).name)
+    run.nwb
     """
     path = _check_path(path)
     ex.check_dataset(dataset, "to_nwb")
@@ -99,6 +134,7 @@ def to_nwb(dataset, path, *, session_description: str | None = None, identifier:
                                                and session_start_time.tzinfo is not None):
         raise TypeError(f"to_nwb: session_start_time must be a timezone-aware datetime.datetime or None, "
                         f"got {session_start_time!r}")
+    _check_pulses(dataset, pulses)
     pynwb = require("pynwb", "to_nwb", "nwb")
     nwbfile = _nwbfile(dataset, pynwb, session_description, identifier, session_start_time)
     starts, stops = _session_clock(dataset)
@@ -106,6 +142,8 @@ def to_nwb(dataset, path, *, session_description: str | None = None, identifier:
     _add_stages(nwbfile, dataset, starts)
     nwbfile.units = _units(dataset, starts)
     _add_forces(nwbfile, dataset, pynwb)
+    if pulses is not None:
+        _add_stimulation(nwbfile, dataset, pulses, starts)
 
     def write(tmp):
         with pynwb.NWBHDF5IO(tmp, "w") as io:
@@ -247,3 +285,90 @@ def _add_forces(nwbfile, ds, pynwb) -> None:
         nwbfile.add_stimulus(pynwb.TimeSeries(
             name=name, data=H5DataIO(data, compression="gzip"), unit="N", rate=float(ds.attrs["fs"]),
             starting_time=0.0, description=description, continuity="continuous"))
+
+
+def _check_pulses(ds, pulses) -> None:
+    """Raise TypeError / ValueError unless ``pulses`` is None or a pulses Dataset of ``ds``'s run."""
+    import xarray as xr
+
+    if pulses is None:
+        return
+    if not isinstance(pulses, xr.Dataset) or pulses.attrs.get("layout") != "ddmm stimulation pulses":
+        raise TypeError(f"to_nwb: pulses must be a pulses Dataset (ddmm.population.stimulation.stimulation_pulses "
+                        f"or load_pulses) or None, got {type(pulses).__name__}")
+    ours, theirs = [str(v) for v in ds["condition"].values], [str(v) for v in pulses["condition"].values]
+    if theirs != ours:
+        raise ValueError(f"to_nwb: pulses are of conditions {theirs}, the dataset's are {ours}; allowed: the "
+                         "pulses of this dataset's run")
+    if pulses.sizes["trial"] != ds.sizes["trial"]:
+        raise ValueError(f"to_nwb: pulses have {pulses.sizes['trial']} trial(s) per condition, the dataset "
+                         f"{ds.sizes['trial']}; allowed: the pulses of this dataset's run")
+    if float(pulses.attrs.get("fs", np.nan)) != float(ds.attrs["fs"]):
+        raise ValueError(f"to_nwb: pulses were made at fs {pulses.attrs.get('fs')} Hz, the dataset has "
+                         f"{ds.attrs['fs']} Hz; allowed: the pulses of this dataset's run")
+    for key in ("seed", "population"):
+        if f"run_{key}" in pulses.attrs and key in ds.attrs and str(pulses.attrs[f"run_{key}"]) != str(ds.attrs[key]):
+            raise ValueError(f"to_nwb: pulses come from a run with {key} {pulses.attrs[f'run_{key}']!r}, the "
+                             f"dataset has {ds.attrs[key]!r}; allowed: the pulses of this dataset's run")
+
+
+def _add_stimulation(nwbfile, ds, pulses, starts) -> None:
+    """``intervals["stimulation_pulses"]`` and ``processing["stimulation"]["stimulation_electrodes"]``."""
+    module = nwbfile.create_processing_module(
+        name="stimulation", description="Stimulation computed from the simulated afferents for a nerve interface "
+                                        "(ddmm.population.stimulation): the electrode table; the pulses are "
+                                        "intervals['stimulation_pulses']")
+    module.add(_electrode_table(pulses))
+    if pulses.sizes["pulse"]:
+        nwbfile.add_time_intervals(_pulse_table(ds, pulses, starts))
+
+
+def _electrode_table(pulses):
+    """One row per electrode: its id, projected field and pulse limits, each description naming its unit."""
+    from hdmf.common import DynamicTable, VectorData
+
+    fields = (("electrode", "electrode id (unitless label; the electrode column of intervals['stimulation_pulses'])"),
+              ("x_mm", "centre x of the disc field in mm (+X radial); NaN for a region field"),
+              ("y_mm", "centre y of the disc field in mm (+Y distal); NaN for a region field"),
+              ("radius_mm", "radius of the disc field in mm; NaN for a region field"),
+              ("region", "hand-map region (or prefix) of a region field; empty for a disc (unitless label)"),
+              ("amplitude_min_ua", "amplitude of the weakest pulse in µA"),
+              ("amplitude_max_ua", "amplitude of the strongest pulse in µA"),
+              ("phase_width_us", "width of each phase in µs"),
+              ("interphase_us", "gap between the two phases in µs"),
+              ("max_rate_hz", "pulse rate limit in Hz (pulses at least 1 / max_rate_hz s apart)"),
+              ("charge_limit_nc", "charge-per-phase limit in nC (amplitude x phase width)"))
+    columns = [VectorData(name=name, description=text, data=[str(v) for v in pulses[name].values]
+                          if name in ("electrode", "region") else pulses[name].values.astype(float))
+               for name, text in fields]
+    return DynamicTable(name="stimulation_electrodes", columns=columns, id=list(range(pulses.sizes["electrode"])),
+                        description="Electrodes of the nerve interface: projected field (a disc in the "
+                                    "population's frame or a hand-map region) and pulse limits, one row each")
+
+
+def _pulse_table(ds, pulses, starts):
+    """The ``stimulation_pulses`` TimeIntervals: one row per pulse on the session clock (module docstring)."""
+    from hdmf.common import VectorData
+    from pynwb.epoch import TimeIntervals
+
+    e, c = pulses.pulse_electrode.values, pulses.pulse_condition.values.astype(np.int64)
+    start = starts[c * ds.sizes["trial"] + pulses.pulse_trial.values] + pulses.pulse_time.values.astype(np.float64)
+    width, gap = pulses.phase_width_us.values[e], pulses.interphase_us.values[e]
+    data = {"start_time": ("start of the cathodic phase in s on the session clock", start),
+            "stop_time": ("end of the anodic phase in s on the session clock", start + (2 * width + gap) * 1e-6),
+            "electrode": ("electrode id (processing['stimulation']['stimulation_electrodes'])",
+                          [str(v) for v in pulses.electrode.values[e]]),
+            "amplitude_ua": ("amplitude of both phases in µA", pulses.pulse_amplitude.values.astype(float)),
+            "phase_width_us": ("width of each phase in µs", width.astype(float)),
+            "interphase_us": ("gap between the phases in µs", gap.astype(float)),
+            "charge_nc": ("charge per phase in nC", pulses.pulse_charge.values.astype(float)),
+            "condition": ("scene name of the condition (as trials.condition)",
+                          [str(v) for v in ds["condition"].values[c]]),
+            "trial": ("trial index within the condition (as trials.trial; integer)",
+                      pulses.pulse_trial.values.astype(np.int64))}
+    settings = ", ".join(f"{k[5:]} {v}" for k, v in pulses.attrs.items() if k.startswith("rule_"))
+    return TimeIntervals(
+        name="stimulation_pulses", id=list(range(pulses.sizes["pulse"])),
+        columns=[VectorData(name=name, description=text, data=values) for name, (text, values) in data.items()],
+        description=f"Stimulation pulses, one row per pulse, times in s on the session clock. Waveform: "
+                    f"{pulses.attrs.get('waveform')}. Rule {pulses.attrs.get('rule')} ({settings}).")

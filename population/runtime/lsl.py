@@ -40,10 +40,12 @@ from ddmm.models._validation import check_positive
 from ddmm.population._extras import require
 from ddmm.population.stimuli.recordings import UNITS
 
-__all__ = ["SPIKE_STREAM_TYPE", "FORCE_STREAM_TYPE", "ForceStream", "SpikeOutlet", "open_force_stream",
+__all__ = ["SPIKE_STREAM_TYPE", "FORCE_STREAM_TYPE", "PULSE_STREAM_TYPE", "ForceStream", "SpikeOutlet", "PulseOutlet",
+           "open_force_stream",
            "open_force_outlet", "read_spike_metadata", "lsl_clock"]
 
 SPIKE_STREAM_TYPE = "Spikes"
+PULSE_STREAM_TYPE = "StimulationPulses"
 FORCE_STREAM_TYPE = "Force"
 #: Unit names a force stream may declare, case-insensitively, and the unit of `UNITS` each means.
 UNIT_NAMES = {**{u.lower(): u for u in UNITS}, "newton": "N", "newtons": "N", "millinewton": "mN",
@@ -343,6 +345,55 @@ class SpikeOutlet:
 
     def close(self) -> None:
         """Withdraw the stream (consumers see it end)."""
+        del self._outlet
+
+
+class PulseOutlet:
+    """The stimulation pulses of a `StimulationEncoder` as an LSL stream.
+
+    Type ``StimulationPulses``, irregular rate, 3 float64 channels: the
+    electrode's position in the table, the amplitude (µA) and the phase width
+    (µs); **one sample per pulse**, stamped like the spikes (the pulse's start
+    on the input's clock).  The meta-data give the waveform, the rule and the
+    electrode table (ids, fields, every limit) under ``desc/electrodes``.
+
+    Examples
+    --------
+    >>> outlet = PulseOutlet("ddmm-doc-pulses", stimulator)  # doctest: +SKIP
+    """
+
+    def __init__(self, name: str, stimulator, *, source_id: str | None = None):
+        pylsl = _pylsl("PulseOutlet")
+        table = stimulator.table
+        digest = hashlib.sha256(f"{name}/{_text(table.ids)}/{stimulator.rule!r}".encode())
+        self.source_id = source_id or "ddmm-pulses-" + digest.hexdigest()[:12]
+        info = pylsl.StreamInfo(name, PULSE_STREAM_TYPE, 3, pylsl.IRREGULAR_RATE, pylsl.cf_double64, self.source_id)
+        desc = info.desc()
+        channels = desc.append_child("channels")
+        for label, unit in (("electrode", "1"), ("amplitude", "uA"), ("phase_width", "us")):
+            channel = channels.append_child("channel")
+            channel.append_child_value("label", label)
+            channel.append_child_value("unit", unit)
+        from ddmm.population.stimulation.encode import WAVEFORM
+
+        desc.append_child_value("waveform", WAVEFORM)
+        desc.append_child_value("rule", repr(stimulator.rule))
+        electrodes = desc.append_child("electrodes")
+        electrodes.append_child_value("id", _text(table.ids))
+        for key in ("x_mm", "y_mm", "radius_mm", "region", "amplitude_min_ua", "amplitude_max_ua", "phase_width_us",
+                    "max_rate_hz", "charge_limit_nc", "interphase_us"):
+            electrodes.append_child_value(key, _text(getattr(e, key) for e in table))
+        self.name = name
+        self._outlet = pylsl.StreamOutlet(info, max_buffered=3600)
+
+    def push(self, electrode, stamps, amplitude_ua, phase_width_us) -> None:
+        """Send pulses: electrode positions, LSL stamps (s), amplitudes (µA), phase widths (µs)."""
+        if len(electrode):
+            rows = np.column_stack([np.asarray(electrode, float), amplitude_ua, phase_width_us])
+            self._outlet.push_chunk(rows, np.asarray(stamps, float).tolist())
+
+    def close(self) -> None:
+        """Withdraw the stream."""
         del self._outlet
 
 

@@ -41,8 +41,8 @@ class BridgeSummary:
 
     Attributes
     ----------
-    samples, spikes : int
-        Input samples taken by the encoder; spikes sent to the sink.
+    samples, spikes, pulses : int
+        Input samples taken by the encoder; spikes sent to the sink; stimulation pulses sent.
     gaps : list of (float, float)
         (stamp of the sample before the gap on this host's LSL clock, gap length) in seconds.
     out_of_order, skipped : int
@@ -53,6 +53,7 @@ class BridgeSummary:
 
     samples: int = 0
     spikes: int = 0
+    pulses: int = 0
     gaps: list = field(default_factory=list)
     out_of_order: int = 0
     skipped: int = 0
@@ -60,7 +61,8 @@ class BridgeSummary:
 
     def describe(self) -> str:
         """One line for a log."""
-        return (f"{self.samples:,} samples in, {self.spikes:,} spikes out, {len(self.gaps)} gap(s), "
+        return (f"{self.samples:,} samples in, {self.spikes:,} spikes out, " +
+                (f"{self.pulses:,} pulses out, " if self.pulses else "") + f"{len(self.gaps)} gap(s), "
                 f"{self.out_of_order} out of order, {self.skipped} skipped" +
                 (f" ({self.stopped})" if self.stopped else ""))
 
@@ -119,6 +121,10 @@ class Bridge:
         a `SpikeOutlet`'s ``push``, for example.
     report : callable, optional
         ``report(message)`` for each gap, out-of-order or skipped sample.
+    stimulator : StimulationEncoder, optional
+        Wraps ``encoder``: samples go through it, and its pulses to ``pulse_sink``.
+    pulse_sink : callable, optional
+        ``pulse_sink(electrode, stamps, amplitude_ua, phase_width_us)``, a `PulseOutlet`'s ``push``.
 
     Examples
     --------
@@ -127,7 +133,10 @@ class Bridge:
     '10,000 samples in, 2,345 spikes out, 0 gap(s), 0 out of order, 0 skipped (duration)'
     """
 
-    def __init__(self, encoder, force: ForceStream, sink, *, report=None):
+    def __init__(self, encoder, force: ForceStream, sink, *, report=None, stimulator=None, pulse_sink=None):
+        if (stimulator is None) != (pulse_sink is None) or (stimulator is not None and stimulator.encoder is not encoder):
+            raise ValueError("stimulator and pulse_sink go together, and the stimulator must wrap this encoder")
+        self.stimulator, self.pulse_sink = stimulator, pulse_sink
         if encoder.fs != force.fs:
             raise ValueError(f"the encoder's fs ({encoder.fs:g} Hz) differs from the stream's ({force.fs:g} Hz)")
         n_sites = 1 if encoder.sites is None else len(encoder.sites)
@@ -185,12 +194,13 @@ class Bridge:
 
     def _push(self, forces) -> None:
         forces = forces.reshape((-1, *self._shape))
+        push = self.encoder.push if self.stimulator is None else self.stimulator.push
         try:
-            spikes = self.encoder.push(forces)
+            spikes = push(forces)
         except ValueError:  # find the refused samples; the encoder's state is untouched by a failed push
             for row in forces:
                 try:
-                    self._send(self.encoder.push(row[None]))
+                    self._send(push(row[None]))
                 except ValueError as exc:
                     self.summary.skipped += 1
                     self._anchor += 1.0 / self.force.fs
@@ -198,7 +208,11 @@ class Bridge:
             return
         self._send(spikes)
 
-    def _send(self, spikes) -> None:
+    def _send(self, out) -> None:
+        spikes = out if self.stimulator is None else out.spikes
+        if self.stimulator is not None and out.electrode.size:
+            self.pulse_sink(out.electrode, self._anchor + out.time, out.amplitude_ua, out.phase_width_us)
+            self.summary.pulses += int(out.electrode.size)
         if spikes.afferent.size:
             self.sink(spikes.afferent, self._anchor + spikes.time)
             self.summary.spikes += int(spikes.afferent.size)

@@ -44,10 +44,14 @@ class StreamSpikes:
         Position of the spiking afferent in the encoder's population.
     time : ndarray of float
         Spike time in seconds since the first sample (``step * dt``).
+    forces : ndarray, shape (m, 3) or (m, n_sites, 3), or None
+        The forces the model consumed in this chunk, N, at ``model_fs``
+        (after the conditioning stage): what a stimulation encoder reads.
     """
 
     afferent: np.ndarray
     time: np.ndarray
+    forces: np.ndarray | None = None
 
 
 class Encoder:
@@ -244,7 +248,7 @@ class Encoder:
             forces, _ = self._conditioner.push(forces)  # may hold back nothing: it is causal, sample by sample
         n = forces.shape[0]
         if n == 0:
-            return StreamSpikes(np.empty(0, np.int64), np.empty(0))
+            return StreamSpikes(np.empty(0, np.int64), np.empty(0), forces)
         state = self._state.copy()  # committed only if the whole chunk succeeds
         afferent, step, neuron = self._pipeline.advance(forces, state, self._samples, self._key, self._neuron, dt=self.dt,
                                                     method=self.method, engine=self._engine, parts=self._parts)
@@ -257,7 +261,7 @@ class Encoder:
         if afferent.size > 1:
             order = np.lexsort((afferent, step))
             afferent, step = afferent[order], step[order]
-        return StreamSpikes(afferent, step * self.dt)
+        return StreamSpikes(afferent, step * self.dt, forces)
 
 
 def _type_positions(population, types) -> np.ndarray:

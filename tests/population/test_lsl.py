@@ -236,3 +236,46 @@ def test_a_missing_extra_is_one_line_naming_the_install(monkeypatch):
     monkeypatch.setitem(sys.modules, "pylsl", None)
     with pytest.raises(MissingExtraError, match=r'pip install "ddmm\[lsl\]"'):
         open_force_stream("anything")
+
+
+def test_stimulation_pulses_over_lsl_equal_the_offline_stimulation_encoder(recording):
+    """--electrodes in closed loop: pulses on an LSL stream equal `StimulationEncoder` on the same samples."""
+    import pylsl
+
+    from ddmm.population.runtime.lsl import PulseOutlet
+    from ddmm.population.stimulation import Electrode, StimulationEncoder
+
+    pop, raw, _, _ = recording
+    table = [Electrode("centre", 20.0, 80.0, 200.0, 300.0, 20.0, x_mm=0.0, y_mm=0.0, radius_mm=5.0),
+             Electrode("D2d", 10.0, 40.0, 100.0, 150.0, 5.0, region="D2d")]
+    names = _name("force"), _name("spikes"), _name("pulses")
+    outlet = open_force_outlet(names[0], fs=FS, units="mN")
+    force = open_force_stream(names[0], timeout=5.0)
+    stimulator = StimulationEncoder(Encoder(pop, force.fs, seed=4), table)
+    stimulator.warm_up()
+    spikes, pulses = SpikeOutlet(names[1], stimulator.encoder, force=force), PulseOutlet(names[2], stimulator)
+    inlet, _ = _spike_inlet(names[2])
+    bridge = Bridge(stimulator.encoder, force, spikes.push, stimulator=stimulator, pulse_sink=pulses.push)
+    deadline = time.monotonic() + 20.0
+    worker = threading.Thread(target=bridge.run, kwargs={"duration": raw.shape[0] / FS,
+                                                         "should_stop": lambda: time.monotonic() > deadline})
+    worker.start()
+    while not outlet.have_consumers() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    t0 = pylsl.local_clock()
+    for a in range(0, raw.shape[0], 50):
+        outlet.push_chunk(raw[a:a + 50], (t0 + np.arange(a, min(a + 50, raw.shape[0])) / FS).tolist())
+    rows, stamps = [], []
+    while time.monotonic() < deadline and (worker.is_alive() or not rows):
+        samples, ts = inlet.pull_chunk(timeout=0.1, max_samples=4096, min_samples=1, as_numpy=True)
+        if len(ts):
+            rows.append(samples)
+            stamps.append(ts)
+    samples, ts = inlet.pull_chunk(timeout=0.5, max_samples=4096, as_numpy=True)
+    rows, stamps = np.concatenate(rows + [samples]), np.concatenate(stamps + [ts])
+    worker.join(5.0)
+    expected = StimulationEncoder(Encoder(pop, FS, seed=4), table).push(raw * 1e-3)
+    assert bridge.summary.pulses == expected.time.size > 20
+    np.testing.assert_array_equal(rows[:, 0].astype(int), expected.electrode)
+    np.testing.assert_array_equal(rows[:, 1], expected.amplitude_ua)
+    np.testing.assert_allclose(stamps - t0 - force.clock_offset_s, expected.time, atol=1e-9)

@@ -221,3 +221,111 @@ def test_existing_file_is_replaced_atomically_and_a_failure_leaves_it(exported, 
     monkeypatch.undo()
     to_nwb(ds, target)
     assert [p.name for p in tmp_path.iterdir()] == ["o.nwb"] and pynwb.validate(path=str(target)) == []
+
+
+# --- stimulation pulses (to_nwb(..., pulses=...), ddmm export --pulses) ---
+
+ELECTRODES = "\n".join([
+    "id,x_mm,y_mm,radius_mm,region,amplitude_min_ua,amplitude_max_ua,phase_width_us,max_rate_hz,charge_limit_nc,"
+    "interphase_us",
+    "E1,0,0,10,,20,80,200,300,20,0",
+    "E2,-5,2,3,,10,60,100,200,10,50",
+    "far,500,0,1,,10,60,100,200,10,0",  # no afferent under it: no pulses
+]) + "\n"
+
+
+@pytest.fixture(scope="module")
+def stimulated(nc, tmp_path_factory):
+    """The `nc` run, its pulses on three electrodes (one far from every afferent: no pulses) and their NWB file."""
+    from ddmm.population.stimulation import stimulation_pulses
+
+    tmp = tmp_path_factory.mktemp("stim")
+    (tmp / "electrodes.csv").write_text(ELECTRODES)
+    ds = load_dataset(nc)
+    pulses = stimulation_pulses(ds, tmp / "electrodes.csv")
+    path = to_nwb(ds, tmp / "stim.nwb", identifier="ddmm-stim", session_start_time=START, pulses=pulses)
+    return ds, pulses, path
+
+
+def test_pulses_read_back_on_the_session_clock(stimulated):
+    ds, pulses, path = stimulated
+    counts = np.bincount(pulses.pulse_electrode.values, minlength=3)
+    assert counts[0] > 100 and counts[1] > 10 and counts[2] == 0
+    assert set(pulses.pulse_condition.values * 2 + pulses.pulse_trial.values) == {0, 1, 2, 3}
+    with pynwb.NWBHDF5IO(path, "r") as io:
+        f = io.read()
+        table = f.intervals["stimulation_pulses"].to_dataframe()
+        trials = f.trials.to_dataframe()
+        assert len(table) == pulses.sizes["pulse"]
+        c, t, e = (pulses[n].values for n in ("pulse_condition", "pulse_trial", "pulse_electrode"))
+        k = c * ds.sizes["trial"] + t
+        starts = trials.start_time.values[k]
+        np.testing.assert_array_equal(trials.condition_index.values[k], c)  # trial k is (c, t) on the trials table
+        # start_time = trials.start_time + pulse_time in float64, to the bit, as for spikes
+        np.testing.assert_array_equal(table.start_time.values, starts + pulses.pulse_time.values)
+        np.testing.assert_allclose(table.start_time.values - starts, pulses.pulse_time.values, rtol=0, atol=1e-12)
+        duration = (2 * pulses.phase_width_us.values[e] + pulses.interphase_us.values[e]) * 1e-6
+        np.testing.assert_allclose(table.stop_time.values - table.start_time.values, duration, rtol=0, atol=1e-12)
+        assert set(np.round((table.stop_time - table.start_time).values * 1e6, 6)) == {400.0, 250.0}
+        np.testing.assert_array_equal(table.amplitude_ua.values, pulses.pulse_amplitude.values)
+        np.testing.assert_array_equal(table.charge_nc.values, pulses.pulse_charge.values)
+        np.testing.assert_array_equal(table.phase_width_us.values, pulses.phase_width_us.values[e])
+        np.testing.assert_array_equal(table.interphase_us.values, pulses.interphase_us.values[e])
+        assert table.electrode.tolist() == pulses.electrode.values[e].tolist()
+        assert table.condition.tolist() == ds.condition.values[c].tolist() and table.trial.tolist() == t.tolist()
+        assert "biphasic" in f.intervals["stimulation_pulses"].description
+        electrodes = f.processing["stimulation"]["stimulation_electrodes"].to_dataframe()
+        assert electrodes.electrode.tolist() == ["E1", "E2", "far"]
+        for name in ("x_mm", "radius_mm", "amplitude_min_ua", "amplitude_max_ua", "max_rate_hz", "charge_limit_nc"):
+            np.testing.assert_array_equal(electrodes[name].values, pulses[name].values, err_msg=name)
+
+
+def test_pulses_file_validates_and_inspects_clean(stimulated):
+    _, _, path = stimulated
+    assert pynwb.validate(path=str(path)) == []
+    inspector = pytest.importorskip("nwbinspector")
+    messages = list(inspector.inspect_nwbfile(nwbfile_path=str(path)))
+    serious = [m for m in messages if m.importance.value >= inspector.Importance.BEST_PRACTICE_VIOLATION.value]
+    assert serious == [], [m.message for m in serious]
+
+
+def test_run_without_pulses_writes_the_electrodes_and_no_empty_table(stimulated, tmp_path):
+    ds, pulses, _ = stimulated
+    none = pulses.isel(electrode=[2], pulse=[])
+    path = to_nwb(ds, tmp_path / "o.nwb", pulses=none)
+    with pynwb.NWBHDF5IO(path, "r") as io:
+        f = io.read()
+        assert "stimulation_pulses" not in f.intervals
+        assert f.processing["stimulation"]["stimulation_electrodes"].electrode[:] == ["far"]
+
+
+@pytest.mark.parametrize("edit,match", [
+    (lambda p: p.isel(condition=[1]), r"pulses are of conditions \['press_push_lift_180'\]"),
+    (lambda p: p.assign_coords(condition=["a", "b"]), r"pulses are of conditions \['a', 'b'\]"),
+    (lambda p: p.isel(trial=[0]), "pulses have 1 trial"),
+    (lambda p: p.assign_attrs(fs=500.0), "pulses were made at fs 500.0 Hz"),
+    (lambda p: p.assign_attrs(run_seed=4), "pulses come from a run with seed 4"),
+])
+def test_pulses_of_another_run_are_refused(stimulated, tmp_path, edit, match):
+    ds, pulses, _ = stimulated
+    with pytest.raises(ValueError, match=match):
+        to_nwb(ds, tmp_path / "o.nwb", pulses=edit(pulses))
+    with pytest.raises(TypeError, match="pulses must be a pulses Dataset"):
+        to_nwb(ds, tmp_path / "o.nwb", pulses=ds)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_cli_export_with_pulses(stimulated, nc, tmp_path, capsys):
+    from ddmm.population.stimulation import save_pulses
+
+    ds, pulses, _ = stimulated
+    pulses_nc = save_pulses(pulses, tmp_path / "pulses.nc")
+    out = tmp_path / "x.nwb"
+    assert main(["export", str(nc), "--nwb", str(out), "--pulses", str(pulses_nc)]) == 0
+    assert capsys.readouterr().out.endswith(f", {pulses.sizes['pulse']} stimulation pulses on 3 electrode(s))\n")
+    with pynwb.NWBHDF5IO(out, "r") as io:
+        table = io.read().intervals["stimulation_pulses"]
+        assert len(table) == pulses.sizes["pulse"]
+        np.testing.assert_array_equal(table["amplitude_ua"][:], pulses.pulse_amplitude.values)
+    assert main(["export", str(nc), "--nwb", str(tmp_path / "y.nwb"), "--pulses", str(tmp_path / "none.nc")]) == 2
+    assert "does not exist" in capsys.readouterr().err and not (tmp_path / "y.nwb").exists()
