@@ -28,6 +28,7 @@ _WHERE = {
     "io.arrays": ("from_array", "from_long_csv", "save_array"),
     "dataset": ("binned_counts", "binned_rates", "describe_dataset", "load_dataset", "psth", "save_dataset"),
     "io.neo_export": ("to_neo",),
+    "io.brian2_export": ("to_brian2",),
     "io.nwb": ("to_nwb",),
     "runtime.plan": ("make_plan",),
     "runtime.stream": ("Encoder",),

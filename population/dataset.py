@@ -44,7 +44,11 @@ from ddmm.population.anatomy.receptive_fields import RF_SIGMA_MM, RF_SUPPORT
 from ddmm.population.io._files import read_netcdf, write_netcdf
 
 __all__ = ["build_dataset", "save_dataset", "load_dataset", "binned_counts", "binned_rates", "psth",
-           "describe_dataset"]
+           "describe_dataset", "cf_attrs", "TIME_ATTRS"]
+
+_HALF_POWER = "a half power of ms: UDUNITS (cf-units) parses it but keeps only integer powers; convert by hand"
+#: The time coordinate's attributes: seconds from the start of a scene, CF's T axis.
+TIME_ATTRS = {"units": "s", "axis": "T", "long_name": "time since the start of the scene"}
 
 
 @functools.lru_cache(maxsize=1)
@@ -84,19 +88,20 @@ def _afferent_coords(population, index) -> dict:
     pop = population
     coords = {
         "afferent": ("afferent", pop.afferent_id[index].astype(np.int64), {"units": "1", "long_name": "afferent id"}),
-        "afferent_type": ("afferent", pop.afferent_type[index].astype(object), {"units": "1"}),
-        "theta_t": ("afferent", pop.theta_t[index].astype(float), {"units": "deg"}),
-        "nap": ("afferent", pop.nap[index].astype(object), {"units": "1"}),
+        "afferent_type": ("afferent", pop.afferent_type[index].astype(object), {"long_name": "afferent type"}),
+        "theta_t": ("afferent", pop.theta_t[index].astype(float), {"units": "degree"}),
+        "nap": ("afferent", pop.nap[index].astype(object), {"long_name": "neural attenuation profile"}),
         "k": ("afferent", pop.k[index].astype(float), {"units": "1", "note": "0 for untuned afferents"}),
         "gain": ("afferent", pop.gain[index].astype(float), {"units": "1"}),
         "x_mm": ("afferent", pop.x_mm[index].astype(float), {"units": "mm"}),
         "y_mm": ("afferent", pop.y_mm[index].astype(float), {"units": "mm"}),
-        "noise_sigma": ("afferent", pop.noise_sigma[index].astype(float), {"units": "mV/sqrt(ms)"}),
-        "noise_cv": ("afferent", pop.noise_cv[index].astype(float), {"units": "sqrt(ms)"}),
+        "noise_sigma": ("afferent", pop.noise_sigma[index].astype(float),
+                        {"units": "mV ms-0.5", "long_name": "current noise SD per sqrt(ms)", "units_note": _HALF_POWER}),
+        "noise_cv": ("afferent", pop.noise_cv[index].astype(float), {"units": "ms0.5", "units_note": _HALF_POWER}),
         "region": ("afferent", pop.region[index].astype(object),
-                   {"units": "1", "long_name": "hand-map region (ddmm.population.anatomy.hand_map), empty when unknown"}),
+                   {"long_name": "hand-map region (ddmm.population.anatomy.hand_map), empty when unknown"}),
         "frame_deg": ("afferent", pop.frame_deg[index].astype(float),
-                      {"units": "deg", "long_name": "rotation from the local digit frame to the hand frame"}),
+                      {"units": "degree", "long_name": "rotation from the local digit frame to the hand frame"}),
     }
     return {k: xr.Variable(*v) for k, v in coords.items()}
 
@@ -110,7 +115,7 @@ def _stage_vars(scenes) -> dict:
         for st in scene.stages:
             start[c, labels.index(st.label)] = st.start
             end[c, labels.index(st.label)] = st.end
-    coord = xr.Variable("stage", np.array(labels, dtype=object), {"units": "1"})
+    coord = xr.Variable("stage", np.array(labels, dtype=object), {"long_name": "stage label"})
     return {"stage": coord,
             "stage_start": xr.Variable(("condition", "stage"), start, {"units": "s"}),
             "stage_end": xr.Variable(("condition", "stage"), end, {"units": "s"})}
@@ -119,9 +124,9 @@ def _stage_vars(scenes) -> dict:
 def _condition_coords(scenes) -> dict:
     theta = [0.0 if s.theta_r is None else float(s.theta_r) % 360.0 for s in scenes]
     return {
-        "condition": xr.Variable("condition", np.array([s.name for s in scenes], dtype=object), {"units": "1"}),
+        "condition": xr.Variable("condition", np.array([s.name for s in scenes], dtype=object), {"long_name": "scene name"}),
         "duration": xr.Variable("condition", np.array([s.duration for s in scenes]), {"units": "s"}),
-        "theta_r": xr.Variable("condition", np.array(theta), {"units": "deg"}),
+        "theta_r": xr.Variable("condition", np.array(theta), {"units": "degree"}),
         "has_theta_r": xr.Variable("condition", np.array([s.theta_r is not None for s in scenes], np.int8),
                                    {"units": "1"}),
         **_contact_coords(scenes),
@@ -234,7 +239,7 @@ def build_dataset(population, scenes, plan, spikes, config) -> xr.Dataset:
         data.update(stages)
     if "forces" in plan.record:
         n_time = max(s.n_samples for s in scenes)
-        coords["time"] = xr.Variable("time", np.arange(n_time) / scenes[0].fs, {"units": "s"})
+        coords["time"] = xr.Variable("time", np.arange(n_time) / scenes[0].fs, dict(TIME_ATTRS))
         for name in ("fx", "fy", "fz"):
             arr = np.zeros((n_c, n_time))
             for c, s in enumerate(scenes):
@@ -242,18 +247,33 @@ def build_dataset(population, scenes, plan, spikes, config) -> xr.Dataset:
             data[name] = xr.Variable(("condition", "time"), arr, {"units": "N"})
     if scenes[0].sites is not None:
         _add_sites(scenes, coords, data, "forces" in plan.record)
-    attrs = dict(model_attrs(population, config), fs=float(scenes[0].fs), trials=n_t)
+    attrs = {**cf_attrs("ddmm simulation of tactile afferent spike trains", population.name),
+             **model_attrs(population, config), "fs": float(scenes[0].fs), "trials": n_t}
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def cf_attrs(title: str, population: str) -> dict:
+    """CF global attributes of the package's netCDF files (Conventions, title, source, history, ...).
+
+    No time stamp: two runs with one seed give identical Datasets (``identical`` holds), attrs included.
+    """
+    return {"Conventions": "CF-1.11", "title": title,
+            "institution": "simulated with ddmm (no recording institution)",
+            "source": f"ddmm {_version()}: Direction-Dependent Mechanotransduction Model, population {population!r}",
+            "history": f"created by ddmm {_version()} (no time stamp, so that equal runs give identical files)",
+            "references": "DDMM paper, data DOI 10.5258/SOTON/D3758; docs/references.md of the ddmm package",
+            "comment": "Simulated, not recorded. Spike events on the spike dimension; every model constant is an "
+                       "attribute."}
 
 
 def _add_sites(scenes, coords, data, forces: bool) -> None:
     """The ``site`` dimension of multi-site runs (all scenes share their sites), and per-site forces."""
     sites = scenes[0].sites
-    coords["site"] = xr.Variable("site", np.asarray(sites.site_id, dtype=object), {"units": "1"})
+    coords["site"] = xr.Variable("site", np.asarray(sites.site_id, dtype=object), {"long_name": "site id"})
     for name, unit in (("x_mm", "mm"), ("y_mm", "mm"), ("radius_mm", "mm"), ("region", "1")):
         values = getattr(sites, name)
         coords[f"site_{name}"] = xr.Variable("site", values.astype(object) if unit == "1" else values,
-                                             {"units": unit})
+                                             {"long_name": "site region"} if unit == "1" else {"units": unit})
     if forces:
         n_time = coords["time"].size
         for axis, name in enumerate(("site_fx", "site_fy", "site_fz")):

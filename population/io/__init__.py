@@ -13,5 +13,6 @@ _WHERE = {
     "arrays": ("from_array", "from_long_csv", "save_array"),
     "nwb": ("to_nwb",),
     "neo_export": ("to_neo",),
+    "brian2_export": ("to_brian2",),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

@@ -70,11 +70,19 @@ from ddmm.population._extras import require
 from ddmm.population.io import _export as ex
 from ddmm.population.io._files import atomic_write, writable_parent
 
-__all__ = ["to_nwb"]
+__all__ = ["to_nwb", "PAPER_DOI", "REFERENCE_START"]
+
+
+#: The default of ``related_publications``: the DOI the DDMM paper gives for its data (the paper's own DOI
+#: is not printed in the copy of its text the package was built from).
+PAPER_DOI = "doi:10.5258/SOTON/D3758"
+#: The session start of a Dataset without a ``date_created`` attribute: a fixed date, so that exports agree.
+REFERENCE_START = _dt.datetime(2000, 1, 1, tzinfo=_dt.timezone.utc)
 
 
 def to_nwb(dataset, path, *, session_description: str | None = None, identifier: str | None = None,
-           session_start_time: _dt.datetime | None = None, pulses=None) -> Path:
+           session_start_time: _dt.datetime | None = None, pulses=None, experimenter=None,
+           institution: str | None = None, related_publications=(PAPER_DOI,)) -> Path:
     """Write a simulation Dataset to an NWB file, atomically (layout in the module docstring).
 
     Parameters
@@ -87,9 +95,22 @@ def to_nwb(dataset, path, *, session_description: str | None = None, identifier:
     session_description : str, optional
         Default: the population, afferent, condition and trial counts.
     identifier : str, optional
-        The file's unique identifier.  Default: a random UUID.
+        The file's unique identifier.  Default: a UUID derived from the
+        Dataset's content (spikes, afferents, conditions, attrs) and the
+        pulses', so two exports of one Dataset carry the same identifier.
     session_start_time : datetime.datetime, optional
-        Timezone-aware origin of the session clock.  Default: now (UTC).
+        Timezone-aware origin of the session clock.  Default: a
+        ``date_created`` attribute of the Dataset when a user set one, else
+        `REFERENCE_START` (2000-01-01 UTC: a simulation has no wall-clock
+        start, and the Dataset carries no time stamp so that equal runs are
+        identical); never "now", so exports agree.
+    experimenter : str or sequence of str, optional
+        Who ran the simulation, as "Last, First" (NWB best practice).
+    institution : str, optional
+        Where.
+    related_publications : sequence of str
+        DOIs or URLs (``"doi:..."``); default the DDMM paper's data DOI
+        (`PAPER_DOI`); ``()`` for none.
     pulses : xarray.Dataset, optional
         Stimulation pulses of this run (`ddmm.population.stimulation.stimulation_pulses`
         or `load_pulses`), written as ``intervals["stimulation_pulses"]`` with the
@@ -135,8 +156,10 @@ def to_nwb(dataset, path, *, session_description: str | None = None, identifier:
         raise TypeError(f"to_nwb: session_start_time must be a timezone-aware datetime.datetime or None, "
                         f"got {session_start_time!r}")
     _check_pulses(dataset, pulses)
+    archive = _archive_fields(experimenter, institution, related_publications)
     pynwb = require("pynwb", "to_nwb", "nwb")
-    nwbfile = _nwbfile(dataset, pynwb, session_description, identifier, session_start_time)
+    nwbfile = _nwbfile(dataset, pynwb, session_description, identifier or _identifier(dataset, pulses),
+                       session_start_time or _start_time(dataset), archive)
     starts, stops = _session_clock(dataset)
     _add_trials(nwbfile, dataset, starts, stops)
     _add_stages(nwbfile, dataset, starts)
@@ -144,6 +167,8 @@ def to_nwb(dataset, path, *, session_description: str | None = None, identifier:
     _add_forces(nwbfile, dataset, pynwb)
     if pulses is not None:
         _add_stimulation(nwbfile, dataset, pulses, starts)
+
+    _derive_object_ids(nwbfile)
 
     def write(tmp):
         with pynwb.NWBHDF5IO(tmp, "w") as io:
@@ -172,7 +197,56 @@ def _check_text(name: str, value) -> None:
         raise ValueError(f"to_nwb: {name} must not be empty, got {value!r}")
 
 
-def _nwbfile(ds, pynwb, description, identifier, start_time):
+def _archive_fields(experimenter, institution, related_publications) -> dict:
+    """The optional archive metadata, checked: experimenter (tuple of str), institution, related_publications."""
+    people = (experimenter,) if isinstance(experimenter, str) else tuple(experimenter or ())
+    pubs = (related_publications,) if isinstance(related_publications, str) else tuple(related_publications or ())
+    for name, values in (("experimenter", people), ("related_publications", pubs)):
+        for value in values:
+            _check_text(name, value)
+    _check_text("institution", institution)
+    fields = {"experimenter": list(people) or None, "institution": institution,
+              "related_publications": list(pubs) or None}
+    return {k: v for k, v in fields.items() if v is not None}
+
+
+def _identifier(ds, pulses) -> str:
+    """A UUID of the Dataset's content (and the pulses'): the same Dataset, the same identifier."""
+    import hashlib
+
+    digest = hashlib.sha256()
+    for var in ("spike_time", "spike_afferent", "spike_trial", "spike_condition", "afferent"):
+        digest.update(np.ascontiguousarray(ds[var].values).tobytes())
+    digest.update("|".join(map(str, ds["condition"].values)).encode())
+    digest.update(ex.attrs_json(ds).encode())
+    if pulses is not None:
+        for var in ("pulse_time", "pulse_electrode", "pulse_amplitude"):
+            digest.update(np.ascontiguousarray(pulses[var].values).tobytes())
+    return str(uuid.uuid5(uuid.NAMESPACE_URL, "ddmm:" + digest.hexdigest()))
+
+
+def _derive_object_ids(nwbfile) -> None:
+    """Object ids from the file's identifier and each object's place, not random: the same content twice.
+
+    hdmf draws a random UUID per object and offers no way to set one after
+    construction, so its private slot is written (only when it exists).
+    """
+    namespace = uuid.uuid5(uuid.NAMESPACE_URL, "ddmm-nwb:" + nwbfile.identifier)
+    for i, obj in enumerate(nwbfile.all_children()):
+        if hasattr(obj, "_AbstractContainer__object_id"):
+            obj._AbstractContainer__object_id = str(uuid.uuid5(namespace, f"{i}:{type(obj).__name__}:{obj.name}"))
+
+
+def _start_time(ds) -> _dt.datetime:
+    """A Dataset's ``date_created`` attribute (UTC) when it has one, else `REFERENCE_START`."""
+    try:
+        start = _dt.datetime.fromisoformat(str(ds.attrs["date_created"]))
+    except (KeyError, ValueError):
+        return REFERENCE_START
+    return start if start.tzinfo is not None else start.replace(tzinfo=_dt.timezone.utc)
+
+
+def _nwbfile(ds, pynwb, description, identifier, start_time, archive):
     """The NWBFile with its metadata (no data yet)."""
     from pynwb.file import Subject
 
@@ -181,13 +255,13 @@ def _nwbfile(ds, pynwb, description, identifier, start_time):
     how = (f"Simulated, not recorded: ddmm {attrs.get('ddmm_version')}, engine {attrs.get('engine')}, method "
            f"{attrs.get('method')}, dt {attrs.get('dt')} s, seed {attrs.get('seed')}, no-shear reading "
            f"{attrs.get('no_shear')}. Every model constant is in notes (JSON of the Dataset attrs).")
-    subject = Subject(subject_id=f"ddmm-{attrs.get('population', 'population')}", species="Homo sapiens", sex="U",
+    subject = Subject(subject_id=f"ddmm-{attrs.get('population', 'population')}-seed{attrs.get('seed')}",
+                      species="Homo sapiens", sex="U",
                       age="P18Y/", description="No real subject: a simulated population of tactile afferents "
                                                "modelled on recordings from adult humans (age: adult, 18 y or over).")
     return pynwb.NWBFile(
         session_description=description or f"ddmm simulation of population {attrs.get('population')!r}: {counts}",
-        identifier=identifier or str(uuid.uuid4()),
-        session_start_time=start_time or _dt.datetime.now(_dt.timezone.utc),
+        identifier=identifier, session_start_time=start_time, **archive,
         experiment_description="Population coding of fingertip forces by tactile afferents, simulated with the "
                                "Direction-Dependent Mechanotransduction Model (DDMM).",
         keywords=["simulation", "tactile afferents", "mechanotransduction", "DDMM"],

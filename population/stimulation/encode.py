@@ -26,6 +26,7 @@ import numpy as np
 import xarray as xr
 
 from ddmm.models.metrics import CONTACT_THRESHOLD
+from ddmm.population.dataset import TIME_ATTRS, cf_attrs
 from ddmm.population.io._files import read_netcdf, write_netcdf
 from ddmm.population.stimulation.electrodes import ElectrodeTable, read_electrodes
 from ddmm.population.stimulation.pulses import PulseKernel, field_weights
@@ -148,9 +149,9 @@ def _pulses_dataset(ds, table, rule, forces, events, traces) -> xr.Dataset:
     for i, (name, unit) in enumerate((("rate_command", "Hz"), ("amplitude_command", "uA"), ("aggregate_rate", "Hz"))):
         data[name] = xr.Variable(dims, traces[i], {"units": unit})
     coords = {"condition": ds.condition.variable, "trial": ds.trial.variable,
-              "time": xr.Variable("time", np.arange(forces.shape[1]) / float(ds.attrs["fs"]), {"units": "s"}),
+              "time": xr.Variable("time", np.arange(forces.shape[1]) / float(ds.attrs["fs"]), dict(TIME_ATTRS)),
               **_electrode_coords(table)}
-    attrs = {"rule": rule.name, **{f"rule_{k}": str(v) for k, v in dataclasses.asdict(rule).items()},
+    attrs = {**cf_attrs("ddmm stimulation pulses", str(ds.attrs.get("population", ""))), "rule": rule.name, **{f"rule_{k}": str(v) for k, v in dataclasses.asdict(rule).items()},
              "waveform": WAVEFORM, "contact_threshold": CONTACT_THRESHOLD, "fs": float(ds.attrs["fs"]),
              **{f"run_{k}": ds.attrs[k] for k in ("population", "seed", "engine", "ddmm_version") if k in ds.attrs},
              "layout": "ddmm stimulation pulses"}
@@ -158,12 +159,12 @@ def _pulses_dataset(ds, table, rule, forces, events, traces) -> xr.Dataset:
 
 
 def _electrode_coords(table) -> dict:
-    coords = {"electrode": xr.Variable("electrode", np.array(table.ids, dtype=object), {"units": "1"})}
+    coords = {"electrode": xr.Variable("electrode", np.array(table.ids, dtype=object), {"long_name": "electrode id"})}
     for name, unit in (("x_mm", "mm"), ("y_mm", "mm"), ("radius_mm", "mm")):
         coords[name] = xr.Variable("electrode", np.array([np.nan if getattr(e, name) is None else getattr(e, name)
                                                           for e in table], float), {"units": unit})
     coords["region"] = xr.Variable("electrode", np.array([e.region or "" for e in table], dtype=object),
-                                   {"units": "1"})
+                                   {"long_name": "hand-map region of a region field, empty for a disc"})
     for name, unit in (("amplitude_min_ua", "uA"), ("amplitude_max_ua", "uA"), ("phase_width_us", "us"),
                        ("max_rate_hz", "Hz"), ("charge_limit_nc", "nC"), ("interphase_us", "us")):
         coords[name] = xr.Variable("electrode", table.column(name), {"units": unit})

@@ -68,3 +68,20 @@ def test_nwb_is_required(capsys, nc):
     with pytest.raises(SystemExit) as info:
         main(["export", str(nc)])
     assert info.value.code == 2 and "--nwb" in capsys.readouterr().err
+
+
+def test_archive_metadata_from_the_command_line(capsys, nc, tmp_path):
+    out = tmp_path / "meta.nwb"
+    code, _, err = run(capsys, "export", nc, "--nwb", out, "--experimenter", "Doe, Jane", "--experimenter",
+                       "Roe, Rick", "--institution", "Lab X", "--related-publication", "doi:10.1000/xyz",
+                       "--identifier", "run-42", "--session-start-time", "2026-11-25T09:30:00+00:00")
+    assert (code, err) == (0, "")
+    with pynwb.NWBHDF5IO(out, "r") as io:
+        f = io.read()
+        assert f.experimenter == ("Doe, Jane", "Roe, Rick") and f.institution == "Lab X"
+        assert f.related_publications == ("doi:10.1000/xyz",) and f.identifier == "run-42"
+        assert f.session_start_time.isoformat() == "2026-11-25T09:30:00+00:00"
+    for bad, message in (("2026-11-25 09:30", "needs a time zone"), ("yesterday", "is not an ISO 8601 date-time")):
+        code, _, err = run(capsys, "export", nc, "--nwb", tmp_path / "bad.nwb", "--session-start-time", bad)
+        assert code == 2 and message in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "bad.nwb").exists()

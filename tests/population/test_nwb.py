@@ -329,3 +329,38 @@ def test_cli_export_with_pulses(stimulated, nc, tmp_path, capsys):
         np.testing.assert_array_equal(table["amplitude_ua"][:], pulses.pulse_amplitude.values)
     assert main(["export", str(nc), "--nwb", str(tmp_path / "y.nwb"), "--pulses", str(tmp_path / "none.nc")]) == 2
     assert "does not exist" in capsys.readouterr().err and not (tmp_path / "y.nwb").exists()
+
+
+def test_two_exports_of_one_dataset_hold_the_same_content(tmp_path):
+    """Identifier, start time and object ids come from the Dataset; only file_create_date may differ."""
+    import h5py
+
+    from ddmm.population import birznieks, make_population, save_dataset, simulate
+    from ddmm.population.io.nwb import PAPER_DOI, REFERENCE_START
+
+    nc = save_dataset(simulate(make_population(["SAI", "RAI"]), birznieks(90.0), engine="direct", seed=3,
+                               quiet=True), tmp_path / "run.nc")
+    ds = load_dataset(nc)
+    paths = [to_nwb(ds, tmp_path / f"{k}.nwb", experimenter="Doe, Jane", institution="Lab") for k in "ab"]
+
+    def content(path):
+        out = {}
+        with h5py.File(path) as f:
+            def visit(name, obj):
+                if isinstance(obj, h5py.Dataset) and name != "file_create_date":
+                    value = obj[()]
+                    out[name] = repr(value.tolist()) if isinstance(value, np.ndarray) else repr(value)
+                out[name + "@"] = repr(sorted((k, str(v)) for k, v in obj.attrs.items()))
+            f.visititems(visit)
+        return out
+    first, second = content(paths[0]), content(paths[1])
+    assert first == second and len(first) > 100
+    with pynwb.NWBHDF5IO(paths[0], "r") as io:
+        f = io.read()
+        assert f.experimenter == ("Doe, Jane",) and f.institution == "Lab" and f.related_publications == (PAPER_DOI,)
+        assert f.session_start_time == REFERENCE_START
+        assert f.subject.subject_id == f"ddmm-{ds.attrs['population']}-seed3"
+        identifier = f.identifier
+    other = simulate(make_population(["SAI", "RAI"]), birznieks(90.0), engine="direct", seed=4, quiet=True)
+    with pynwb.NWBHDF5IO(to_nwb(other, tmp_path / "c.nwb"), "r") as io:
+        assert io.read().identifier != identifier  # another run, another identifier

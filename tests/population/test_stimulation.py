@@ -218,3 +218,23 @@ def test_check_pulses_finds_tampering_and_save_refuses_it(presses, tmp_path):
     with pytest.raises(ValueError, match="refusing to write pulses that break their limits"):
         save_pulses(bad, tmp_path / "bad.nc")
     assert not (tmp_path / "bad.nc").exists()
+
+
+@settings(max_examples=8, deadline=None)
+@given(table=_tables(), rule=st.sampled_from(RULES), seed=st.integers(0, 2**32 - 1))
+def test_every_limit_holds_on_random_multi_site_scenes(table, rule, seed):
+    """Random presses and slides on four taxels, simulated, then encoded: `check_pulses` finds nothing."""
+    rng = np.random.default_rng(seed)
+    n, knots = 400, np.linspace(0.0, 0.4, 6)
+    t = np.arange(n) / 1000.0
+    forces = np.zeros((n, 4, 3))
+    for s in range(4):
+        forces[:, s, 2] = np.interp(t, knots, rng.uniform(0, 2, 6) * (rng.uniform(size=6) > 0.3))
+        forces[:, s, :2] = np.interp(t, knots, rng.uniform(-0.3, 0.3, 6))[:, None] * (forces[:, s, 2:3] > 0)
+    forces *= ((t > 0.05) & (t < 0.3))[:, None, None]  # no contact at the start and the end
+    sites = Sites(rng.uniform(-4, 4, 4), rng.uniform(-4, 4, 4), 1.5)
+    pop = sample_population("fingertip", rng=0).select(np.arange(0, 991, 4))
+    ds = simulate(pop, Scene.from_sites(forces, sites, 1000.0, "random"), engine="direct", seed=seed % 1000,
+                  quiet=True)
+    pulses = stimulation_pulses(ds, table, rule)
+    assert check_pulses(pulses) == []
