@@ -3,6 +3,8 @@
 - `tuning`: direction tuning as microneurography measures it;
 - `decode`: shear-direction decoders (population vector, maximum likelihood,
   first-spike latency);
+- `ml`: the decoders as scikit-learn estimators, and `features` for them
+  (needs scikit-learn: ``pip install 'ddmm[ml]'``; imported only on use);
 - `array_decode`: torque and slip from force fields;
 - `physiology`: the physiology scorecard against human recordings.
 """
@@ -13,6 +15,8 @@ _WHERE = {
     "tuning": ("direction_tuning", "tuning_scenes", "tuning_summary"),
     "decode": ("DECODERS", "FirstSpikeLatency", "MaximumLikelihood", "PopulationVector", "angular_error",
                "select_afferents", "window_responses"),
+    "ml": ("ESTIMATORS", "FirstSpikeLatencyDecoder", "MaximumLikelihoodDecoder", "PopulationVectorDecoder",
+           "circular_score", "features"),
     "array_decode": ("CentroidClassifier", "SlipDetector", "evaluate_slip", "onset_counts", "stage_onset"),
     "physiology": ("PROPERTIES", "score_physiology", "summarise_scorecard"),
 }

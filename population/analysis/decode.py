@@ -22,6 +22,12 @@ first sample with F_Z above `ddmm.models.metrics.CONTACT_THRESHOLD`).
   used, and a test trial is decoded by weighted least-squares matching of
   the latencies (Johansson & Birznieks 2004: ensembles signal direction by
   their first spikes).
+
+Their math is also exposed on plain arrays (rows are observations, columns
+afferents, angles in radians): `count_normalisation` with `population_vector`,
+`poisson_tuning` with `poisson_decode`, `latency_tuning` with
+`latency_decode`; `ddmm.population.analysis.ml` builds scikit-learn
+estimators on them.
 """
 
 from __future__ import annotations
@@ -33,9 +39,9 @@ from scipy.optimize import minimize
 
 from ddmm.models.metrics import CONTACT_THRESHOLD
 
-__all__ = ["angular_error", "contact_onset", "window_responses", "select_afferents", "population_vector",
-           "PopulationVector",
-           "MaximumLikelihood", "FirstSpikeLatency", "DECODERS"]
+__all__ = ["angular_error", "to_degrees", "contact_onset", "window_responses", "select_afferents",
+           "check_training", "population_vector", "count_normalisation", "poisson_tuning", "poisson_decode",
+           "latency_tuning", "latency_decode", "PopulationVector", "MaximumLikelihood", "FirstSpikeLatency", "DECODERS"]
 
 _GRID = np.deg2rad(np.arange(0.0, 360.0, 0.5))
 
@@ -52,6 +58,18 @@ def angular_error(a_deg, b_deg) -> np.ndarray:
     return np.minimum(d, 360.0 - d)
 
 
+def to_degrees(theta_rad) -> np.ndarray:
+    """Angles in radians as degrees in [0, 360) (``np.mod`` alone can round -1e-15 up to 360.0).
+
+    Examples
+    --------
+    >>> to_degrees([-np.pi / 2, 2 * np.pi, -1e-17]).tolist()
+    [270.0, 0.0, 0.0]
+    """
+    deg = np.mod(np.rad2deg(np.asarray(theta_rad, float)), 360.0)
+    return np.where(deg >= 360.0, 0.0, deg)
+
+
 def contact_onset(ds: xr.Dataset) -> np.ndarray:
     """Contact onset per condition in seconds (first F_Z sample above the contact threshold)."""
     if "fz" not in ds:
@@ -63,8 +81,11 @@ def contact_onset(ds: xr.Dataset) -> np.ndarray:
     return ds.time.values[above.argmax(axis=1)]
 
 
-def window_responses(ds: xr.Dataset, window_s: float):
+def window_responses(ds: xr.Dataset, window_s: float, *, start_s: float | None = None):
     """Counts and first-spike latencies in [onset, onset + window) per (condition, trial, afferent).
+
+    The window opens at contact onset (`contact_onset`), or at ``start_s``
+    seconds after every scene's start when given.
 
     Returns
     -------
@@ -73,13 +94,16 @@ def window_responses(ds: xr.Dataset, window_s: float):
     """
     if not (isinstance(window_s, (int, float)) and window_s > 0):
         raise ValueError(f"window_s must be > 0 s, got {window_s!r}")
+    if start_s is not None and not (isinstance(start_s, (int, float)) and 0 <= start_s < np.inf):
+        raise ValueError(f"start_s must be None (contact onset) or a time >= 0 s, got {start_s!r}")
     if "spike_time" not in ds:
         raise ValueError("decoding needs spike events; simulate with record including 'spikes'")
-    onset = contact_onset(ds)
+    onset = contact_onset(ds) if start_s is None else np.full(ds.sizes["condition"], float(start_s))
     too_long = onset + window_s > ds.duration.values + 1e-12
     if too_long.any():
         c = int(np.flatnonzero(too_long)[0])
-        raise ValueError(f"window of {window_s * 1e3:g} ms after contact onset ({onset[c] * 1e3:g} ms) is longer "
+        where = "contact onset" if start_s is None else "start_s"
+        raise ValueError(f"window of {window_s * 1e3:g} ms after {where} ({onset[c] * 1e3:g} ms) is longer "
                          f"than condition {str(ds.condition.values[c])!r} ({ds.duration.values[c] * 1e3:g} ms)")
     cond, trial, aff = (ds[v].values for v in ("spike_condition", "spike_trial", "spike_afferent"))
     rel = ds.spike_time.values - onset[cond]
@@ -106,15 +130,21 @@ def select_afferents(ds: xr.Dataset, positions) -> xr.Dataset:
     return out
 
 
+def check_training(angles_deg, need: int, distinct: int, who: str, unit: str = "trials") -> None:
+    """Raise ValueError unless ``angles_deg`` holds ``need`` observations over ``distinct`` directions."""
+    n_obs = int(np.size(angles_deg))
+    n_dir = np.unique(np.round(np.mod(angles_deg, 360.0), 6)).size
+    if n_obs < need or n_dir < distinct:
+        raise ValueError(f"{who} needs at least {need} {unit} with a shear direction, spanning at least "
+                         f"{distinct} distinct directions; got {n_obs} {unit} over {n_dir} directions")
+
+
 def _labelled(ds: xr.Dataset, features, need: int, distinct: int, who: str):
     """Observations with a known direction: (features of shape (obs, afferent, ...), angles deg)."""
     has = ds.has_theta_r.values == 1
     n_obs = int(has.sum()) * ds.sizes["trial"]
-    n_dir = np.unique(np.round(ds.theta_r.values[has], 6)).size
-    if n_obs < need or n_dir < distinct:
-        raise ValueError(f"{who} needs at least {need} trials with a shear direction, spanning at least "
-                         f"{distinct} distinct directions; got {n_obs} trials over {n_dir} directions")
     angles = np.repeat(ds.theta_r.values[has], ds.sizes["trial"])
+    check_training(angles, need, distinct, who)
     return [f[has].reshape(n_obs, *f.shape[2:]) for f in features], angles
 
 
@@ -156,9 +186,9 @@ class _Decoder:
         features = self._features(ds)
         n_c, n_t = ds.sizes["condition"], ds.sizes["trial"]
         flat = [f.reshape(n_c * n_t, *f.shape[2:]) for f in features]
-        theta = np.mod(np.rad2deg(self._predict(*flat)), 360.0).reshape(n_c, n_t)
+        theta = to_degrees(self._predict(*flat)).reshape(n_c, n_t)
         return xr.DataArray(theta, dims=("condition", "trial"), coords={"condition": ds.condition, "trial": ds.trial},
-                            attrs={"units": "deg", "decoder": self.name, "window_s": self.window_s})
+                            attrs={"units": "degree", "decoder": self.name, "window_s": self.window_s})
 
 
 def population_vector(responses, theta_t_deg, nap, baseline, scale) -> np.ndarray:
@@ -178,14 +208,19 @@ def population_vector(responses, theta_t_deg, nap, baseline, scale) -> np.ndarra
     return np.angle(uni + np.abs(axial) * np.exp(1j * pick))
 
 
+def count_normalisation(counts):
+    """The population vector's ``(baseline, scale)`` per afferent: training mean, and SD + 1 spike."""
+    counts = np.asarray(counts, float)
+    return counts.mean(axis=0), counts.std(axis=0) + 1.0  # the scale equalises afferents with different rates
+
+
 class PopulationVector(_Decoder):
     """Rate-weighted unit vectors at theta_T; bipolar afferents axial (see `population_vector`)."""
 
     name = "population_vector"
 
     def _fit(self, ds, counts, latency, angles):
-        self.baseline_ = counts.mean(axis=0)
-        self.scale_ = counts.std(axis=0) + 1.0  # equalises afferents with different rates
+        self.baseline_, self.scale_ = count_normalisation(counts)
         self.theta_t_, self.nap_ = ds.theta_t.values, ds.nap.values
 
     def _predict(self, counts, latency):
@@ -200,29 +235,42 @@ class MaximumLikelihood(_Decoder):
     ridge = 1e-2  # penalty on the non-constant coefficients, keeps silent afferents finite
 
     def _fit(self, ds, counts, latency, angles):
-        x = _harmonics(angles)  # (obs, 5)
-        y = counts.astype(float)  # (obs, afferent)
-        n_aff = y.shape[1]
-        b0 = np.zeros((5, n_aff))
-        b0[0] = np.log(y.mean(axis=0) + 0.1)
-        penalty = np.r_[0.0, np.full(4, self.ridge)][:, None]
-
-        def loss(flat):
-            b = flat.reshape(5, n_aff)
-            eta = np.clip(x @ b, -30.0, 30.0)
-            mu = np.exp(eta)
-            value = np.sum(mu - y * eta) + 0.5 * np.sum(penalty * b * b) * len(y)
-            grad = x.T @ (mu - y) + penalty * b * len(y)
-            return value, grad.ravel()
-
-        res = minimize(loss, b0.ravel(), jac=True, method="L-BFGS-B", options={"maxiter": 500})
-        self.coef_ = res.x.reshape(5, n_aff)
-        log_rate = np.clip(_harmonics(_GRID) @ self.coef_, -30.0, 30.0)  # (grid, afferent)
-        self._grid_log_rate, self._grid_rate = log_rate, np.exp(log_rate).sum(axis=1)
+        self.coef_ = poisson_tuning(counts, angles, self.ridge)
 
     def _predict(self, counts, latency):
-        ll = counts @ self._grid_log_rate.T - self._grid_rate  # (obs, grid)
-        return _refine_on_grid(ll)
+        return poisson_decode(counts, self.coef_)
+
+
+def poisson_tuning(counts, angles_rad, ridge: float = MaximumLikelihood.ridge) -> np.ndarray:
+    """Coefficients (5, afferent) of each afferent's Poisson log-rate, a 2nd-order Fourier series of direction.
+
+    Penalised maximum likelihood (L-BFGS): ``ridge`` weighs the squared
+    non-constant coefficients per observation (keeps silent afferents finite).
+    """
+    x = _harmonics(np.asarray(angles_rad, float))  # (obs, 5)
+    y = np.asarray(counts, float)  # (obs, afferent)
+    n_aff = y.shape[1]
+    b0 = np.zeros((5, n_aff))
+    b0[0] = np.log(y.mean(axis=0) + 0.1)
+    penalty = np.r_[0.0, np.full(4, ridge)][:, None]
+
+    def loss(flat):
+        b = flat.reshape(5, n_aff)
+        eta = np.clip(x @ b, -30.0, 30.0)
+        mu = np.exp(eta)
+        value = np.sum(mu - y * eta) + 0.5 * np.sum(penalty * b * b) * len(y)
+        grad = x.T @ (mu - y) + penalty * b * len(y)
+        return value, grad.ravel()
+
+    res = minimize(loss, b0.ravel(), jac=True, method="L-BFGS-B", options={"maxiter": 500})
+    return res.x.reshape(5, n_aff)
+
+
+def poisson_decode(counts, coef) -> np.ndarray:
+    """Maximum-likelihood direction (radians) of each row of ``counts`` under `poisson_tuning`'s ``coef``."""
+    log_rate = np.clip(_harmonics(_GRID) @ coef, -30.0, 30.0)  # (grid, afferent)
+    ll = np.asarray(counts, float) @ log_rate.T - np.exp(log_rate).sum(axis=1)  # (obs, grid)
+    return _refine_on_grid(ll)
 
 
 class FirstSpikeLatency(_Decoder):
@@ -233,30 +281,43 @@ class FirstSpikeLatency(_Decoder):
     alpha = 0.01  # significance of latency tuning for an afferent to be used
 
     def _fit(self, ds, counts, latency, angles):
-        # A silent afferent reads as "latency >= window": the clipped latency
-        # is a complete, bounded feature, so every trial enters the fit.
-        x = _harmonics(angles)  # (obs, 5)
-        coef, *_ = np.linalg.lstsq(x, latency, rcond=None)  # (5, afferent)
-        n = latency.shape[0]
-        ss_full = ((latency - x @ coef) ** 2).sum(axis=0)
-        ss_flat = ((latency - latency.mean(axis=0)) ** 2).sum(axis=0)
-        dof = max(n - 5, 1)
-        self.sigma_ = np.sqrt(ss_full / dof) + 1e-4  # s; floor for perfectly regular units
-        # Keep afferents whose latency depends on direction (F-test of the
-        # Fourier fit against a constant): flat, noisy curves of hundreds of
-        # untuned afferents would otherwise swamp the score with overfit wiggles.
-        with np.errstate(divide="ignore", invalid="ignore"):
-            f_stat = ((ss_flat - ss_full) / 4.0) / (ss_full / dof)
-        p = np.where(ss_full > 0, stats.f.sf(f_stat, 4, dof), np.where(ss_flat > 0, 0.0, 1.0))
-        self.usable_ = p < self.alpha
-        if not self.usable_.any():  # no information: decode from the best there is (about chance level)
-            self.usable_ = p <= p.min()
-        self._grid_latency = _harmonics(_GRID) @ coef  # (grid, afferent)
+        self.coef_, self.sigma_, self.usable_ = latency_tuning(latency, angles, self.alpha)
 
     def _predict(self, counts, latency):
-        pred = self._grid_latency[None, :, self.usable_]  # (1, grid, used)
-        miss = (latency[:, None, self.usable_] - pred) / self.sigma_[self.usable_]
-        return _refine_on_grid(-0.5 * np.sum(miss**2, axis=2))
+        return latency_decode(latency, self.coef_, self.sigma_, self.usable_)
+
+
+def latency_tuning(latency, angles_rad, alpha: float = FirstSpikeLatency.alpha):
+    """Least-squares latency curves: ``(coef (5, afferent), sigma (afferent,) in s, usable (afferent,) bool)``.
+
+    ``usable`` marks afferents whose latency is tuned (F-test of the Fourier
+    fit against a constant, p < ``alpha``); when none is, the best one.
+    """
+    # A silent afferent reads as "latency >= window": the clipped latency
+    # is a complete, bounded feature, so every trial enters the fit.
+    latency = np.asarray(latency, float)
+    x = _harmonics(np.asarray(angles_rad, float))  # (obs, 5)
+    coef, *_ = np.linalg.lstsq(x, latency, rcond=None)  # (5, afferent)
+    ss_full = ((latency - x @ coef) ** 2).sum(axis=0)
+    ss_flat = ((latency - latency.mean(axis=0)) ** 2).sum(axis=0)
+    dof = max(latency.shape[0] - 5, 1)
+    sigma = np.sqrt(ss_full / dof) + 1e-4  # s; floor for perfectly regular units
+    # Keep afferents whose latency depends on direction: flat, noisy curves of hundreds
+    # of untuned afferents would otherwise swamp the score with overfit wiggles.
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f_stat = ((ss_flat - ss_full) / 4.0) / (ss_full / dof)
+    p = np.where(ss_full > 0, stats.f.sf(f_stat, 4, dof), np.where(ss_flat > 0, 0.0, 1.0))
+    usable = p < alpha
+    if not usable.any():  # no information: decode from the best there is (about chance level)
+        usable = p <= p.min()
+    return coef, sigma, usable
+
+
+def latency_decode(latency, coef, sigma, usable) -> np.ndarray:
+    """Direction (radians) of each row of ``latency`` by weighted least squares against `latency_tuning`'s curves."""
+    pred = (_harmonics(_GRID) @ coef)[None, :, usable]  # (1, grid, used)
+    miss = (np.asarray(latency, float)[:, None, usable] - pred) / sigma[usable]
+    return _refine_on_grid(-0.5 * np.sum(miss**2, axis=2))
 
 
 def _refine_on_grid(score: np.ndarray) -> np.ndarray:

@@ -37,7 +37,7 @@ def test_noiseless_cosine_population_decodes_within_1_degree(decoder, train, tes
     decoded = decoder(0.2).fit(train).predict(test_set)
     err = angular_error(decoded.values.ravel(), test_set.theta_r.values)
     assert err.max() < 1.0
-    assert decoded.dims == ("condition", "trial") and decoded.attrs["units"] == "deg"
+    assert decoded.dims == ("condition", "trial") and decoded.attrs["units"] == "degree"
 
 
 def test_latency_decoder_on_cosine_latencies():
