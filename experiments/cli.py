@@ -82,6 +82,9 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("ddmm: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader went away (``ddmm ... | head``): stop quietly, as shell tools do
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except Exception as exc:  # noqa: BLE001 - the CLI never shows a traceback unless asked
         if debug:
             raise

@@ -7,19 +7,19 @@ emits nothing while the force under the field is at or below the contact
 threshold (0.05 N, `ddmm.models.metrics.CONTACT_THRESHOLD`).
 
 **biomimetic** (`Biomimetic`), after the biomimetic encoders of Okorokova et
-al. (2018), Valle et al. (2018) and George et al. (2019) (recalled, not read:
-docs/references.md).  The pulse rate follows the aggregate firing rate of the
+al. (2018), Valle et al. (2018) and George et al. (2019) (Okorokova's abstract read,
+the others recalled: docs/references.md).  The pulse rate follows the aggregate firing rate of the
 afferents in the electrode's projected field, and the amplitude follows how
 many of them are active, so that stimulation recruits more fibres when more
 afferents would fire:
 
 * aggregate rate ``r`` (spikes/s per field afferent): the weighted spike count
   of the field's afferents per sample, divided by their number, smoothed by a
-  causal exponential of time constant ``tau_s``.  Every spike counts
-  ``weights[type]``; with the default weights FA-I and FA-II count twice,
-  so contact onsets and offsets (their bursts) dominate the rate, as the
-  sources' emphasis on transients does (the factor is a choice, not a value
-  read in them);
+  causal exponential of time constant ``tau_s``.  Okorokova et al. (2018;
+  abstract read) drive stimulation by the time-varying *population* firing
+  rate, so by default every spike counts once (``weights`` 1 for each type):
+  the FA-I and FA-II bursts at contact onset and offset are the transients,
+  as they are in the nerve.  ``weights`` can stress them further;
 * rate command ``max_rate_hz x min(r / rate_sat_hz, 1)``;
 * active fraction ``a``: field afferents that fired in the last
   ``active_window_s``, over their number; amplitude command
@@ -82,7 +82,7 @@ class Biomimetic:
     rate_sat_hz: float = 100.0
     active_window_s: float = 0.02
     active_sat: float = 0.5
-    weights: tuple = (("SAI", 1.0), ("RAI", 2.0), ("RAII", 2.0), ("SAII", 1.0))
+    weights: tuple = (("SAI", 1.0), ("RAI", 1.0), ("RAII", 1.0), ("SAII", 1.0))
     name = "biomimetic"
     code = 0
 
