@@ -8,7 +8,24 @@ import re
 
 import numpy as np
 
-__all__ = ["as_finite_array", "check_positive", "check_choice", "check_forces", "parse_number"]
+__all__ = ["as_finite_array", "check_positive", "check_choice", "check_forces", "parse_number", "shown"]
+
+
+def shown(value) -> str:
+    """A value as a message prints it: numbers plainly (``0.5``, not ``np.float64(0.5)``), anything else by repr.
+
+    Examples
+    --------
+    >>> shown(np.float64(0.5)), shown(np.int64(3)), shown("x"), shown(float("nan"))
+    ('0.5', '3', "'x'", 'nan')
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Number, np.number)):
+        return repr(value)
+    if isinstance(value, (numbers.Integral, np.integer)):
+        return str(int(value))
+    if isinstance(value, (numbers.Real, np.floating)):
+        return repr(float(value))
+    return repr(value)
 
 
 def as_finite_array(value, name: str, ndim: int | None = None) -> np.ndarray:
@@ -42,7 +59,7 @@ def check_positive(value, name: str, unit: str = "") -> float:
     value = float(value)
     if not np.isfinite(value) or value <= 0.0:
         suffix = f" {unit}" if unit else ""
-        raise ValueError(f"{name} must be a finite number > 0{suffix}, got {value!r}")
+        raise ValueError(f"{name} must be a finite number > 0{suffix}, got {shown(value)}")
     return value
 
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models._validation import check_positive
+from ddmm.models._validation import check_positive, shown
 from ddmm.models.afferent_types import normalize_type
 
 __all__ = ["DERIVATIVE_ORDER", "CurrentParams", "CurrentStage"]
@@ -224,25 +224,24 @@ class CurrentParams:
             if value is None and name == "order_raii":
                 continue
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 8:
-                raise ValueError(f"{name} must be an int in [1, 8], got {value!r}")
+                raise ValueError(f"{name} must be an int in [1, 8], got {shown(value)}")
         if not self.fall_sai < 1.0:
-            raise ValueError(f"fall_sai must be a number in [0, 1), got {self.fall_sai!r}")
+            raise ValueError(f"fall_sai must be a number in [0, 1), got {shown(self.fall_sai)}")
         if isinstance(self.phase_saii, bool) or not isinstance(self.phase_saii, (int, float)) \
                 or not 0.0 <= self.phase_saii <= 1.0:
-            raise ValueError(f"phase_saii must be a number in [0, 1], got {self.phase_saii!r}")
+            raise ValueError(f"phase_saii must be a number in [0, 1], got {shown(self.phase_saii)}")
         for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii", "normal_saii",
                      "bias_cv_saii", "dynamic_sai", "fall_sai", "excite_cv_sai", "excite_cv_rai", "excite_cv_raii",
                      "excite_cv_saii", "shear_sai", "shear_rai", "shear_raii", "opponent_shear_sai",
                      "opponent_shear_rai", "opponent_shear_raii"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
-                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+                raise ValueError(f"{name} must be a finite number >= 0, got {shown(value)}")
         for name in ("negative_weight_rai", "negative_weight_raii"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
-                number = isinstance(value, (int, float)) and not isinstance(value, bool)
-                shown = f"{float(value):g}" if number else repr(value)
-                raise ValueError(f"{name} must be a number in [0, 1] (1: the paper's absolute value), got {shown}")
+                raise ValueError(f"{name} must be a number in [0, 1] (1: the paper's absolute value), "
+                                 f"got {shown(value)}")
 
     def _own(self, prefix: str, afferent_type: str, suffix: str = "", default=None):
         """The per-type field ``<prefix>_<type><suffix>`` (e.g. ``i_max_raii``), or ``default`` if it has none."""

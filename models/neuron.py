@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ddmm.models._validation import shown
+
 from ddmm.models.currents import AFFERENT_TYPES, normalize_type
 
 __all__ = [
@@ -123,7 +125,7 @@ def resting_state(b) -> tuple[np.ndarray, np.ndarray]:
     b = np.asarray(b, dtype=float)
     disc = (5.0 - b) ** 2 - 4.0 * 0.04 * 140.0
     if np.any(disc < 0.0):
-        raise ValueError(f"b={b!r} leaves eq. 4-5 without a resting state (b must be <= 0.267)")
+        raise ValueError(f"b={shown(b)} leaves eq. 4-5 without a resting state (b must be <= 0.267)")
     v = (-(5.0 - b) - np.sqrt(disc)) / (2.0 * 0.04)
     return v, b * v
 

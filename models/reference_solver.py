@@ -17,6 +17,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from ddmm.models._validation import shown
+
 from ddmm.models.neuron import V_PEAK
 
 __all__ = ["reference_spike_times"]
@@ -132,7 +134,7 @@ def reference_spike_times(current, fs: float, params: dict, v0, u0, *, dt_ref: f
     sample_ms = 1000.0 / fs
     steps = int(round((1.0 / fs) / dt_ref))
     if steps < 1 or abs(steps * dt_ref * fs - 1.0) > 1e-9:
-        raise ValueError(f"dt_ref={dt_ref!r} s must divide the sample interval 1/fs = {1.0 / fs!r} s")
+        raise ValueError(f"dt_ref={shown(dt_ref)} s must divide the sample interval 1/fs = {shown(1.0 / fs)} s")
     t_ref_ms = 1000.0 * np.asarray(params.get("t_ref", np.zeros(current.shape[0])), dtype=float)
     times = []
     for j in range(current.shape[0]):

@@ -23,6 +23,8 @@ import math
 import numba as nb
 import numpy as np
 
+from ddmm.models._validation import shown
+
 __all__ = ["philox4x32", "stream_key", "normal", "normal_row", "normals"]
 
 _M0, _M1 = np.uint64(0xD2511F53), np.uint64(0xCD9E8D57)
@@ -167,7 +169,7 @@ def stream_key(seed: int, condition: int, trial: int) -> int:
     """
     for value, name in ((seed, "seed"), (condition, "condition"), (trial, "trial")):
         if int(value) < 0:
-            raise ValueError(f"{name} must be >= 0, got {value!r}")
+            raise ValueError(f"{name} must be >= 0, got {shown(value)}")
     seed = int(seed) & ((1 << 64) - 1)
     words = philox4x32(np.uint64(int(condition) & 0xFFFFFFFF), np.uint64(int(trial) & 0xFFFFFFFF),
                        np.uint64((int(condition) >> 32) & 0xFFFFFFFF), np.uint64(0x6464_6D6D),

@@ -35,6 +35,8 @@ from pathlib import Path
 
 import numba as nb
 import numpy as np
+
+from ddmm.models._validation import shown
 import xarray as xr
 
 from ddmm.models.attenuation import F_TH
@@ -310,7 +312,7 @@ def binned_counts(ds: xr.Dataset, bin_s: float, *, t_max: float | None = None) -
     if "spike_time" not in ds:
         raise ValueError("the dataset has no spike events; simulate with record including 'spikes'")
     if not bin_s > 0:
-        raise ValueError(f"bin_s must be > 0, got {bin_s!r}")
+        raise ValueError(f"bin_s must be > 0, got {shown(bin_s)}")
     t_max = float(ds.duration.max()) if t_max is None else t_max
     edges = np.arange(0.0, t_max + bin_s / 2, bin_s)
     n_bins = max(1, edges.size - 1)

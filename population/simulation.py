@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ddmm.models._resources import check_memory
-from ddmm.models._validation import check_choice, check_positive
+from ddmm.models._validation import check_choice, check_positive, shown
 from ddmm.models.attenuation import F_TH, NO_SHEAR_READINGS
 from ddmm.models.current_filters import check_fs
 from ddmm.models.engines import METHODS, get_engine, prepare, substeps_for
@@ -239,7 +239,7 @@ def _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_si
         if name == "chunk_size" and value is None:
             continue  # the engine's default
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-            raise ValueError(f"{name} must be a whole number >= 1, got {value!r}")
+            raise ValueError(f"{name} must be a whole number >= 1, got {shown(value)}")
     return scenes
 
 

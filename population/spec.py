@@ -49,6 +49,7 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
+from ddmm.models._validation import shown
 from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import UNTUNED
 from ddmm.models.current_params import CurrentParams
@@ -90,11 +91,11 @@ def _fail(key: str, message: str):
 
 def _finite(key: str, value, *, positive=False, nonneg=False) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        _fail(key, f"must be a number, got {value!r}")
+        _fail(key, f"must be a number, got {shown(value)}")
     value = float(value)
     if not math.isfinite(value) or (positive and value <= 0) or (nonneg and value < 0):
         need = "> 0" if positive else ">= 0" if nonneg else "finite"
-        _fail(key, f"must be {need}, got {value!r}")
+        _fail(key, f"must be {need}, got {shown(value)}")
     return value
 
 
@@ -177,7 +178,7 @@ class SharpnessDistribution:
             _finite(f"sharpness.{name}", getattr(self, name))
         object.__setattr__(self, "values", tuple(_finite("sharpness.values", v) for v in self.values))
         if self.distribution == "uniform" and not self.low < self.high:
-            _fail("sharpness", f"uniform needs low < high, got low={self.low!r}, high={self.high!r}")
+            _fail("sharpness", f"uniform needs low < high, got low={shown(self.low)}, high={shown(self.high)}")
         if self.distribution == "list" and not self.values:
             _fail("sharpness.values", "a list distribution needs at least one value")
 
@@ -302,7 +303,7 @@ class TypeSpec:
         if self.count is not None and (isinstance(self.count, bool) or not isinstance(self.count, int)
                                        or not 0 <= self.count <= MAX_COUNT):
             _fail("count", f"must be a whole number in [0, {MAX_COUNT:,}] (a hand has about 17,000 afferents), "
-                           f"got {self.count!r}")
+                           f"got {shown(self.count)}")
         if self.density_per_cm2 is not None:
             _finite("density_per_cm2", self.density_per_cm2, nonneg=True)
             if self.density_per_cm2 > MAX_DENSITY_PER_CM2:
@@ -313,7 +314,7 @@ class TypeSpec:
                 _fail(f"nap.{name}", f"unknown NAP; allowed: {', '.join(NAP_CHOICES)}")
         fracs = {k: _finite(f"nap.{k}", v, nonneg=True) for k, v in self.nap.items()}
         if not math.isclose(sum(fracs.values()), 1.0, abs_tol=1e-6):
-            _fail("nap", f"fractions must sum to 1, got {sum(fracs.values())!r}")
+            _fail("nap", f"fractions must sum to 1, got {shown(sum(fracs.values()))}")
         object.__setattr__(self, "nap", fracs)
         sharp = dict(DEFAULT_SHARPNESS, **self.sharpness)
         for name in sharp:

@@ -42,6 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ddmm.models._validation import shown
+
 __all__ = ["Ellipse", "Polygon", "HandRegion", "KINDS", "TYPES", "DENSITY_PER_CM2", "TYPE_SHARE",
            "REGIONS", "region_names", "get_region", "region_at", "sample_in_region", "region_counts",
            "region_table", "outline"]
@@ -369,7 +371,7 @@ def sample_in_region(name: str, n: int, rng=None) -> np.ndarray:
     """
     region = get_region(name)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
-        raise ValueError(f"n must be a whole number >= 0, got {n!r}")
+        raise ValueError(f"n must be a whole number >= 0, got {shown(n)}")
     return region.shape.sample(int(n), np.random.default_rng(rng))
 
 

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models._validation import check_positive
+from ddmm.models._validation import check_positive, shown
 from ddmm.population._extras import require
 from ddmm.population.stimuli.recordings import UNITS
 
@@ -214,9 +214,9 @@ def open_force_stream(name: str, *, n_sites: int = 1, fs: float | None = None, u
     pylsl = _pylsl("open_force_stream")
     timeout = check_positive(timeout, "timeout", "s")
     if isinstance(n_sites, bool) or not isinstance(n_sites, (int, np.integer)) or n_sites < 1:
-        raise ValueError(f"n_sites must be a positive integer, got {n_sites!r}")
+        raise ValueError(f"n_sites must be a positive integer, got {shown(n_sites)}")
     if fz_sign not in (1, -1):
-        raise ValueError(f"fz_sign must be 1 or -1, got {fz_sign!r}")
+        raise ValueError(f"fz_sign must be 1 or -1, got {shown(fz_sign)}")
     found = _resolve(pylsl, name, source_id, timeout)
     if found.channel_count() != 3 * n_sites:
         raise ValueError(f"LSL stream {name!r} has {found.channel_count()} channels; {n_sites} site(s) need "

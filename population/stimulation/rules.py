@@ -41,6 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ddmm.models._validation import shown
 from ddmm.models.afferent_types import AFFERENT_TYPES as TYPES
 
 __all__ = ["Biomimetic", "LinearAmplitude", "LinearFrequency", "RULES", "get_rule"]
@@ -166,7 +167,7 @@ class LinearFrequency:
     def __post_init__(self):
         number = isinstance(self.amplitude_fraction, (int, float)) and not isinstance(self.amplitude_fraction, bool)
         if not number or not 0.0 <= self.amplitude_fraction <= 1.0:
-            raise ValueError(f"{self.name}: amplitude_fraction must be in [0, 1], got {self.amplitude_fraction!r}")
+            raise ValueError(f"{self.name}: amplitude_fraction must be in [0, 1], got {shown(self.amplitude_fraction)}")
         _positive(self.name, "force_sat_n", self.force_sat_n)
 
     def type_weights(self, afferent_type) -> np.ndarray:

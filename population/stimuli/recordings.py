@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ddmm.models._resources import check_memory
-from ddmm.models._validation import check_positive, parse_number
+from ddmm.models._validation import check_positive, parse_number, shown
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.scenes import DEFAULT_FS, MAX_FS, Contact, Scene
 
@@ -242,7 +242,7 @@ def _check_options(fs, units, fz_sign, negative_fz, gaps, conditioning) -> None:
         if value not in allowed:
             raise ValueError(f"{name}={value!r} is not allowed; allowed: {', '.join(allowed)}")
     if fz_sign not in (1, -1) or isinstance(fz_sign, bool):
-        raise ValueError(f"fz_sign must be 1 or -1, got {fz_sign!r}")
+        raise ValueError(f"fz_sign must be 1 or -1, got {shown(fz_sign)}")
     if conditioning is not None and not isinstance(conditioning, Conditioning):
         raise TypeError(f"conditioning must be a Conditioning or None, got {type(conditioning).__name__}")
 

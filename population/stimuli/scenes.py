@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ddmm.models._resources import check_memory
-from ddmm.models._validation import as_finite_array, check_positive
+from ddmm.models._validation import as_finite_array, check_positive, shown
 
 __all__ = [
     "DEFAULT_FS",
@@ -50,7 +50,7 @@ class Contact:
         for name in ("x_mm", "y_mm"):
             value = getattr(self, name)
             if not np.isfinite(value):
-                raise ValueError(f"contact {name} must be finite, got {value!r}")
+                raise ValueError(f"contact {name} must be finite, got {shown(value)}")
         check_positive(self.radius_mm, "contact radius_mm", "mm")
         if self.radius_mm > MAX_RADIUS_MM:
             raise ValueError(f"contact radius_mm must be <= {MAX_RADIUS_MM:g} mm (a contact larger than a hand), "
@@ -140,7 +140,7 @@ class Stage:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
                     or not np.isfinite(value):
-                raise ValueError(f"stage {self.label!r}: {name} must be a finite number of seconds, got {value!r}")
+                raise ValueError(f"stage {self.label!r}: {name} must be a finite number of seconds, got {shown(value)}")
         if not 0.0 <= self.start <= self.end:  # an empty stage (a zero-length ramp) is allowed
             raise ValueError(f"stage {self.label!r} must start at or after 0 s and end no earlier, got "
                              f"{float(self.start):g}-{float(self.end):g} s")
@@ -217,7 +217,7 @@ class Scene:
                                  f"end at {duration:g} s")
         if self.theta_r is not None and not (isinstance(self.theta_r, (int, float, np.floating, np.integer))
                                              and np.isfinite(self.theta_r)):
-            raise ValueError(f"theta_r must be a finite angle in degrees or None, got {self.theta_r!r}")
+            raise ValueError(f"theta_r must be a finite angle in degrees or None, got {shown(self.theta_r)}")
 
     def _check_sites(self, n_samples: int) -> None:
         if (self.sites is None) != (self.site_forces is None):
@@ -293,13 +293,13 @@ def _check_site_fz(forces, sites, fs) -> None:
 
 def _check_delay(shear_delay_s, ramp_s) -> None:
     if not (isinstance(shear_delay_s, (int, float)) and 0.0 <= shear_delay_s < ramp_s):
-        raise ValueError(f"shear_delay_s must be in [0, ramp_s = {ramp_s:g}) s, got {shear_delay_s!r}")
+        raise ValueError(f"shear_delay_s must be in [0, ramp_s = {ramp_s:g}) s, got {shown(shear_delay_s)}")
 
 
 def _samples(duration: float, fs: float) -> np.ndarray:
     check_positive(fs, "fs", "Hz")
     if not (np.isfinite(duration) and duration > 0):
-        raise ValueError(f"a scene's duration must be a finite number of seconds > 0, got {duration!r}")
+        raise ValueError(f"a scene's duration must be a finite number of seconds > 0, got {shown(duration)}")
     n = int(round(duration * fs))
     # the times, three forces and the builders' temporaries: about eight float64 arrays of n samples
     check_memory(64.0 * n, f"a scene of {duration:g} s at {fs:g} Hz ({n:,} samples)", "shorten it or lower fs")
@@ -338,7 +338,7 @@ def birznieks(direction_deg: float | None = 90.0, *, normal_n: float = 4.0, angl
     """
     _check_delay(shear_delay_s, ramp_s)
     if not (isinstance(angle_deg, (int, float)) and 0.0 <= angle_deg <= MAX_INCLINATION_DEG):
-        raise ValueError(f"angle_deg must be in [0, {MAX_INCLINATION_DEG:g}] degrees from the normal, got {angle_deg!r}")
+        raise ValueError(f"angle_deg must be in [0, {MAX_INCLINATION_DEG:g}] degrees from the normal, got {shown(angle_deg)}")
     t = _samples(2 * ramp_s + hold_s, fs)
     knots = [0.0, ramp_s, ramp_s + hold_s, 2 * ramp_s + hold_s]
     profile = np.interp(t, knots, [0.0, 1.0, 1.0, 0.0])
@@ -385,7 +385,7 @@ def press_push_lift(theta_r: float = 90.0, *, press_n: float = 3.0, push_n: floa
     lift_s = ramp_s if lift_ramp_s is None else lift_ramp_s
     for name, value, top in (("ramp_s", ramp_s, 10.0), ("lift_ramp_s", lift_s, 5.0)):
         if not (isinstance(value, (int, float)) and 0.0 < value <= top):
-            raise ValueError(f"{name} must be in (0, {top:g}] s, got {value!r}")
+            raise ValueError(f"{name} must be in (0, {top:g}] s, got {shown(value)}")
     _check_delay(shear_delay_s, ramp_s)
     t = _samples(30.0, fs)
     knots = [0.0, 5.0, 5.0 + ramp_s, 15.0, 15.0 + ramp_s, 25.0, 25.0 + lift_s, 30.0]

@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models._validation import check_positive
+from ddmm.models._validation import check_positive, shown
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Scene, Sites, Stage, taxel_radius
 
 __all__ = ["contact_grid", "torsion", "incipient_slip", "grasp", "digit_tip_sites"]
@@ -117,9 +117,9 @@ def torsion(torque_mnm: float = 5.0, normal_n: float = 3.0, radius_mm: float = 6
     (112, 3.0, 'torque_ramp')
     """
     if direction not in (1, -1):
-        raise ValueError(f"direction must be +1 or -1, got {direction!r}")
+        raise ValueError(f"direction must be +1 or -1, got {shown(direction)}")
     if not np.isfinite(torque_mnm) or torque_mnm < 0:
-        raise ValueError(f"torque_mnm must be finite and >= 0 mNm, got {torque_mnm!r}")
+        raise ValueError(f"torque_mnm must be finite and >= 0 mNm, got {shown(torque_mnm)}")
     check_positive(normal_n, "normal_n", "N")
     sites, dx, dy = contact_grid(radius_mm, pitch_mm, center_mm=center_mm, region=region)
     knots = [0.0, ramp_s, preload_s, preload_s + ramp_s, preload_s + ramp_s + hold_s,

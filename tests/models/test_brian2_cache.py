@@ -67,3 +67,29 @@ def test_an_unsafe_cache_directory_is_refused(tmp_path):
     with pytest.raises(ValueError, match="must be a directory, not a symlink"):
         private_dir(link)
     assert oct(os.stat(private_dir(tmp_path / "new" / "deep")).st_mode & 0o777) == "0o700"
+
+
+def test_a_build_killed_midway_leaves_nothing_where_the_cache_looks(tmp_path, monkeypatch):
+    """Builds go to a temporary directory installed by rename: a failure midway leaves no project at the key,
+    the next build sweeps what a killed one left, and installs a verified binary."""
+    monkeypatch.setenv("DDMM_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(engine, "_BUILDS", {})
+    key = (8, 300, 10, 1e-4, "euler")
+    directory = engine._key_dir(key)
+    generate = engine._generate
+
+    def killed(key, where, shown=None):
+        (where / "half_written.o").write_bytes(b"\0" * 10)
+        raise KeyboardInterrupt  # as a signal would, midway
+    monkeypatch.setattr(engine, "_generate", killed)
+    with pytest.raises(KeyboardInterrupt):
+        engine._build(key)
+    assert not directory.exists() and not list(directory.parent.glob(f".{directory.name}.build-*"))
+    (directory.parent / f".{directory.name}.build-left").mkdir()  # what a SIGKILL would leave
+    monkeypatch.setattr(engine, "_generate", generate)
+    build = engine._build(key)
+    assert build.directory == directory and engine._verified(directory)
+    assert not list(directory.parent.glob(f".{directory.name}.build-*"))
+    first = integrate(_current(), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")
+    direct = integrate(_current(), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="direct")
+    np.testing.assert_array_equal(first.step, direct.step)

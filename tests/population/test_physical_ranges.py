@@ -91,3 +91,17 @@ def test_hdf5_links_are_refused(tmp_path):
         fh["region"] = h5py.ExternalLink(str(other), "region")
     with pytest.raises(ValueError, match=r"'region' must be a dataset stored in the file, not a link"):
         from_array(path)
+
+
+@pytest.mark.parametrize("call, text", [
+    (lambda: __import__("ddmm.population", fromlist=["birznieks"]).birznieks(90.0, hold_s=np.float64(-1.0)),
+     "got -0.75"),
+    (lambda: __import__("ddmm.population", fromlist=["birznieks"]).birznieks(90.0, angle_deg=np.float64(95.0)),
+     "got 95.0"),
+    (lambda: __import__("ddmm.models.neuron", fromlist=["NeuronParams"]).NeuronParams(b=np.float64(0.5)),
+     "0.5"),
+])
+def test_numpy_numbers_print_plainly_in_messages(call, text):
+    with pytest.raises(ValueError) as info:
+        call()
+    assert text in str(info.value) and "np." not in str(info.value)

@@ -45,11 +45,14 @@ import hashlib
 import logging
 import os
 import platform
+import shutil
 import subprocess
 import sys
+import tempfile
 import threading
 import warnings
 from contextlib import contextmanager
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -269,23 +272,45 @@ def _build(key: tuple) -> _Build:
     """
     directory = _key_dir(key)
     with _build_lock(directory):
-        if (directory / "main").exists() and not _verified(directory):
+        for stale in directory.parent.glob(f".{directory.name}.build-*"):  # a killed build's leftovers
+            shutil.rmtree(stale, ignore_errors=True)
+        if _verified(directory):
+            return _generate(key, directory)  # installed and intact: make finds nothing to do
+        if (directory / "main").exists():
             print(f"ddmm: the cached Brian2 binary {directory / 'main'} does not match its recorded digest "
                   "(damaged or replaced): rebuilding it", file=sys.stderr, flush=True)
-            (directory / "main").unlink()
-        build = _generate(key, directory)
-        _record_digest(directory)
-    return build
+        return _install(key, directory)
 
 
-def _generate(key: tuple, directory: Path) -> _Build:
-    """Generate the project into ``directory`` and compile what is missing (``make`` skips what is current)."""
+def _install(key: tuple, directory: Path) -> _Build:
+    """Build into a fresh temporary directory and install it by an atomic rename: a build killed midway
+    leaves no half-built project where the cache looks (only a temporary directory the next build sweeps)."""
+    tmp = Path(tempfile.mkdtemp(prefix=f".{directory.name}.build-", dir=directory.parent))
+    try:
+        build = _generate(key, tmp, shown=directory)
+        _record_digest(tmp)
+        if directory.exists():  # damaged, or an older layout: move it aside first (rename is atomic)
+            aside = Path(tempfile.mkdtemp(prefix=f".{directory.name}.build-", dir=directory.parent))
+            os.replace(directory, aside / "old")
+            shutil.rmtree(aside, ignore_errors=True)
+        os.replace(tmp, directory)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return dataclasses.replace(build, directory=directory)
+
+
+def _generate(key: tuple, directory: Path, shown: Path | None = None) -> _Build:
+    """Generate the project into ``directory`` and compile what is missing (``make`` skips what is current).
+
+    ``shown``: the directory the notice names (where the build is installed), default ``directory``.
+    """
     n_neurons, n_samples, substeps, dt, method = key
     compiled = (directory / "main").exists()
     if not compiled:
         print(
             f"ddmm: compiling the Brian2 engine for {n_neurons} neurons x {n_samples} samples "
-            f"(dt={dt * 1e3:g} ms, {method}); once per shape, cached in {directory} (--engine direct gives the "
+            f"(dt={dt * 1e3:g} ms, {method}); once per shape, cached in {shown or directory} (--engine direct gives the "
             f"same spikes with no compile)",
             file=sys.stderr,
             flush=True,
