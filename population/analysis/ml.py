@@ -52,7 +52,7 @@ __all__ = ["features", "circular_score", "PopulationVectorDecoder", "MaximumLike
            "FirstSpikeLatencyDecoder", "ESTIMATORS", "expected_failed_checks"]
 
 KINDS = ("count", "latency")
-GROUPINGS = ("condition", "direction")
+GROUPINGS = ("condition", "direction", "trial")
 
 
 def features(dataset: xr.Dataset, window_s: float = 0.125, *, start_s: float | None = None, kind: str = "count",
@@ -74,7 +74,7 @@ def features(dataset: xr.Dataset, window_s: float = 0.125, *, start_s: float | N
         the same for every sample, and the Poisson likelihood needs counts).
         ``"latency"``: first-spike latency after the window start (s),
         ``window_s`` when silent (`FirstSpikeLatencyDecoder`'s input).
-    group_by : {"condition", "direction"}
+    group_by : {"condition", "direction", "trial"}
         What a cross-validation group is (see Notes).
     drop_unlabelled : bool
         Leave out conditions without a shear direction instead of raising.
@@ -98,6 +98,9 @@ def features(dataset: xr.Dataset, window_s: float = 0.125, *, start_s: float | N
     held-out scene is held out together, and a test direction is decoded
     from other scenes.  ``group_by="direction"`` also pools conditions that
     share a direction (e.g. one scene repeated under two names).
+    ``group_by="trial"`` makes the trial index the group (every direction on
+    both sides, repeats held out): it measures trial-to-trial generalisation,
+    and is meaningful only for a population with noise.
 
     Examples
     --------
@@ -119,8 +122,11 @@ def features(dataset: xr.Dataset, window_s: float = 0.125, *, start_s: float | N
     values = counts if kind == "count" else latency
     n_t = dataset.sizes["trial"]
     theta = dataset.theta_r.values[has].astype(float)
+    rows = values[has].reshape(-1, values.shape[2])
+    if group_by == "trial":
+        return rows, np.repeat(theta, n_t), np.tile(np.arange(n_t, dtype=np.int64), int(has.sum()))
     key = np.flatnonzero(has) if group_by == "condition" else np.unique(np.round(theta, 6), return_inverse=True)[1]
-    return values[has].reshape(-1, values.shape[2]), np.repeat(theta, n_t), np.repeat(key, n_t).astype(np.int64)
+    return rows, np.repeat(theta, n_t), np.repeat(key, n_t).astype(np.int64)
 
 
 def _labelled_conditions(dataset: xr.Dataset, drop: bool) -> np.ndarray:

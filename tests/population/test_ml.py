@@ -167,7 +167,7 @@ def test_bad_input(sim):
         PopulationVectorDecoder().predict(X)
     with pytest.raises(ValueError, match="X has 3 features, but PopulationVectorDecoder is expecting 12"):
         PopulationVectorDecoder().fit(X, y).predict(X[:, :3])
-    for kwargs, match in (({"kind": "rate"}, "kind must be one of"), ({"group_by": "trial"}, "group_by must be"),
+    for kwargs, match in (({"kind": "rate"}, "kind must be one of"), ({"group_by": "repeat"}, "group_by must be"),
                           ({"window_s": 0.0}, "window_s must be > 0"), ({"start_s": -1.0}, "start_s must be"),
                           ({"start_s": 0.48}, "after start_s .* is longer than condition")):
         with pytest.raises(ValueError, match=match):
@@ -192,3 +192,16 @@ def test_analysis_package_imports_without_touching_sklearn():
             "try:\n    a.features\nexcept ImportError as e:\n    print(e)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert "needs scikit-learn" in out and "pip install 'ddmm[ml]'" in out
+
+
+def test_trials_as_groups_hold_out_repeats_at_every_direction():
+    from ddmm.population import birznieks, make_population, simulate
+
+    pop = make_population(["SAI", "RAI", "SAII"] * 4, theta_t=np.arange(0, 360, 30), nap="selective", noise_cv=0.3)
+    ds = simulate(pop, [birznieks(d) for d in range(0, 360, 45)], engine="direct", trials=3, seed=2, quiet=True)
+    X, y, groups = features(ds, 0.1, group_by="trial")
+    assert groups.tolist() == [0, 1, 2] * 8
+    for train, test in GroupKFold(n_splits=3).split(X, y, groups):
+        assert set(y[train]) == set(y[test]) and len(set(groups[test])) == 1
+    scores = cross_val_score(MaximumLikelihoodDecoder(), X, y, groups=groups, cv=GroupKFold(n_splits=3))
+    assert scores.mean() > 0.5
