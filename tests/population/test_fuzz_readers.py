@@ -110,3 +110,39 @@ def test_npz_fields(tmp_path_factory, fields):
             from_array(path)
         except (ValueError, TypeError):
             pass
+
+
+_ELECTRODE_FIELDS = ["id", "x_mm", "y_mm", "radius_mm", "region", "amplitude_min_ua", "amplitude_max_ua",
+                     "phase_width_us", "max_rate_hz", "charge_limit_nc", "interphase_us", "ID", "foo", ""]
+
+
+@_FUZZ
+@given(header=st.lists(st.sampled_from(_ELECTRODE_FIELDS), min_size=0, max_size=11),
+       rows=st.lists(st.lists(_CELL, min_size=0, max_size=11), max_size=5))
+def test_electrode_table_csv_reader(tmp_path_factory, header, rows):
+    from ddmm.population.stimulation import ElectrodeTable, read_electrodes
+
+    path = tmp_path_factory.mktemp("electrodes") / "e.csv"
+    path.write_text(_csv_text([header] + rows))
+    try:
+        table = read_electrodes(path)
+    except (ValueError, TypeError) as exc:
+        assert "e.csv" in str(exc), exc
+        return
+    assert isinstance(table, ElectrodeTable)
+    for e in table:  # whatever was accepted holds its own limits
+        assert 0 < e.amplitude_min_ua <= e.amplitude_max_ua and e.max_charge_nc <= e.charge_limit_nc * (1 + 1e-12)
+        assert e.pulse_s < e.min_interval_s
+
+
+@_FUZZ
+@given(text=st.text(max_size=300), nested=st.integers(0, 3000))
+def test_electrode_table_toml_reader(tmp_path_factory, text, nested):
+    from ddmm.population.stimulation import read_electrodes
+
+    path = tmp_path_factory.mktemp("electrodes") / "e.toml"
+    path.write_text(("x = " + "[" * nested + "]" * nested + "\n") if nested > 2 else text)
+    try:
+        read_electrodes(path)
+    except (ValueError, TypeError) as exc:
+        assert "e.toml" in str(exc), exc
