@@ -226,6 +226,7 @@ def _stimulator(args, encoder):
     from ddmm.population.stimulation import StimulationEncoder, read_electrodes
 
     stimulator = StimulationEncoder(encoder, read_electrodes(args.electrodes), args.rule)
+    stimulator.warm_up()  # before its stream appears: a consumer that sees it finds the bridge ready
     outlet = PulseOutlet(args.lsl_pulses, stimulator)
     print(f"ddmm: publishing {args.rule} pulses of {len(stimulator.table)} electrode(s) on LSL stream "
           f"{args.lsl_pulses!r} (type StimulationPulses, source id {outlet.source_id})", file=sys.stderr, flush=True)
@@ -244,7 +245,8 @@ def _run_lsl(args, sites) -> int:
     try:
         encoder = _encoder(args, force.fs, sites)
         stimulator, pulses = _stimulator(args, encoder)
-        (encoder if stimulator is None else stimulator).warm_up()  # before the inlet opens: nothing piles up
+        if stimulator is None:
+            encoder.warm_up()  # before the inlet opens and the spikes' stream appears
         sink, outlet = _spike_sink(args, encoder, force)
         bridge = Bridge(encoder, force, sink, report=lambda m: print(f"ddmm: {m}", file=sys.stderr, flush=True),
                         stimulator=stimulator, pulse_sink=None if pulses is None else pulses.push)

@@ -153,3 +153,45 @@ def test_the_bench_latency_is_per_sample_until_its_last_spike():
     anchor = 10.0  # due time of sample 0 on this host's clock
     arrivals = [(10.0009, np.array([10.00005, 10.00095])), (10.0035, np.array([10.0001, 10.0031]))]
     np.testing.assert_allclose(_latencies(pushed, anchor, arrivals), [0.0035 - 0.0002, 0.0035 - 0.0032])
+
+
+def test_stream_publishes_stimulation_pulses_equal_to_the_in_process_encoder(tmp_path):
+    """``ddmm stream --lsl-in F --electrodes E.csv --lsl-pulses P`` in another process: the pulses read here."""
+    import pylsl
+
+    from ddmm.population.stimulation import StimulationEncoder, read_electrodes
+
+    table = tmp_path / "e.csv"
+    table.write_text("id,x_mm,y_mm,radius_mm,region,amplitude_min_ua,amplitude_max_ua,phase_width_us,max_rate_hz,"
+                     "charge_limit_nc\ncentre,0,0,5,,20,80,200,300,20\nedge,4,4,3,,10,60,100,200,10\n")
+    force, pulses = _name("force"), _name("pulses")
+    scene = birznieks(90.0)
+    raw = np.column_stack([scene.fx, scene.fy, scene.fz])
+    outlet = open_force_outlet(force, fs=1000.0)
+    proc = _ddmm("stream", "--lsl-in", force, "--electrodes", str(table), "--lsl-pulses", pulses, "--seed", "5",
+                 "--lsl-out", _name("spikes"),  # spikes off stdout: an unread pipe would fill and block
+                 "--types", "SAI,RAI", "--duration", f"{raw.shape[0] / 1000.0}", "--resolve-timeout", "60")
+    try:
+        inlet, _ = _inlet(pulses, 90.0)
+        deadline = time.monotonic() + 60.0
+        while not outlet.have_consumers() and time.monotonic() < deadline:  # the bridge opens its inlet
+            time.sleep(0.01)
+        t0 = pylsl.local_clock()
+        outlet.push_chunk(raw, (t0 + np.arange(raw.shape[0]) / 1000.0).tolist())
+        rows, stamps, deadline = [], [], time.monotonic() + 60.0
+        while time.monotonic() < deadline and (proc.poll() is None or not rows):
+            samples, ts = inlet.pull_chunk(timeout=0.2, max_samples=4096, min_samples=1, as_numpy=True)
+            if len(ts):
+                rows.append(samples)
+                stamps.append(np.asarray(ts))
+        out, err = proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+    assert proc.returncode == 0, err
+    pop = sample_population("fingertip", rng=5)
+    expected = StimulationEncoder(Encoder(pop, 1000.0, seed=5, types=("SAI", "RAI")),
+                                  read_electrodes(table)).push(raw)
+    got = np.concatenate(rows)
+    assert f"{expected.time.size:,} pulses out" in err and expected.time.size > 20
+    np.testing.assert_array_equal(got[:, 0].astype(int), expected.electrode)
+    np.testing.assert_array_equal(got[:, 1], expected.amplitude_ua)
