@@ -58,7 +58,7 @@ def test_stream_over_lsl_equals_the_in_process_encoder():
         for a in range(0, raw.shape[0], 7):
             outlet.push_chunk(raw[a:a + 7], (t0 + np.arange(a, min(a + 7, raw.shape[0])) / 500.0).tolist())
             time.sleep(0.002)
-        ids, stamps = [], []
+        ids, stamps, chunk_len = [], [], 1
         deadline = time.monotonic() + 60.0
         while time.monotonic() < deadline and (proc.poll() is None or len(ids) == 0 or chunk_len):
             samples, ts = inlet.pull_chunk(timeout=0.2, max_samples=4096, min_samples=1, as_numpy=True)
