@@ -96,6 +96,11 @@ def check_stamps(stamps, last: float | None, fs: float):
     stamps = np.asarray(stamps, dtype=float)
     keep, excess = np.ones(stamps.size, bool), np.zeros(stamps.size)
     previous = -np.inf if last is None else float(last)
+    step = np.diff(np.r_[previous, stamps])
+    if np.all(step > 0):  # the usual case, vectorised: nothing out of order
+        gap = np.isfinite(step) & (step > GAP_FACTOR / fs)
+        excess[gap] = step[gap] - 1.0 / fs
+        return keep, excess
     for i, stamp in enumerate(stamps):  # sequential: a dropped sample is not the "previous" one
         if not stamp > previous:
             keep[i] = False
