@@ -427,13 +427,13 @@ def _describe(desc, encoder, force) -> None:
                              ("x_mm", pop.x_mm[pos], repr), ("y_mm", pop.y_mm[pos], repr),
                              ("region", pop.region[pos], str), ("theta_t_deg", pop.theta_t[pos], repr),
                              ("nap", pop.nap[pos], str)):
-        afferents.append_child_value(key, _text(values, lambda v, f=fmt: f(v.item() if hasattr(v, "item") else v)))
+        afferents.append_child_value(key, _text(np.asarray(values).tolist(), fmt))
     if encoder.sites is not None:
         sites = desc.append_child("sites")
         for key, values in (("id", encoder.sites.site_id), ("x_mm", encoder.sites.x_mm),
                             ("y_mm", encoder.sites.y_mm), ("radius_mm", encoder.sites.radius_mm),
                             ("region", encoder.sites.region)):
-            sites.append_child_value(key, _text(values, lambda v: str(v.item() if hasattr(v, "item") else v)))
+            sites.append_child_value(key, _text(np.asarray(values).tolist()))
 
 
 def read_spike_metadata(info) -> dict:

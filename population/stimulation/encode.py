@@ -29,7 +29,7 @@ from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.population.dataset import TIME_ATTRS, cf_attrs
 from ddmm.population.io._files import read_netcdf, write_netcdf
 from ddmm.population.stimulation.electrodes import ElectrodeTable, read_electrodes
-from ddmm.population.stimulation.pulses import PulseKernel, field_weights
+from ddmm.population.stimulation.pulses import PulseKernel, contact_weights, field_weights
 from ddmm.population.stimulation.rules import get_rule
 
 __all__ = ["stimulation_pulses", "check_pulses", "save_pulses", "load_pulses", "as_table", "WAVEFORM"]
@@ -47,38 +47,22 @@ def as_table(electrodes) -> ElectrodeTable:
     return ElectrodeTable(electrodes)
 
 
-def _sites_of(ds):
-    """(x_mm, y_mm, radius_mm, region, forces (condition, time, site)) of a run's force sites."""
-    from ddmm.population.anatomy.hand_map import region_at
-
+def _field_forces(ds, table) -> np.ndarray:
+    """(condition, time, electrode): the normal force under each field, N (module docstring of `pulses`)."""
     if "site" in ds.dims:
         if "site_fz" not in ds:
             raise ValueError("the dataset has sites but no per-site forces (site_fz): simulate with the forces "
                              "recorded")
-        return (ds.site_x_mm.values, ds.site_y_mm.values, ds.site_radius_mm.values, ds.site_region.values,
-                ds.site_fz.values)
+        weights = field_weights(table, ds.site_x_mm.values, ds.site_y_mm.values, ds.site_radius_mm.values,
+                                ds.site_region.values)
+        return np.einsum("cts,es->cte", ds.site_fz.values, weights)
     if "fz" not in ds:
         raise ValueError("the dataset has no forces (fz): simulate with the forces recorded")
     n_c = ds.sizes["condition"]
-    if "contact_radius_mm" in ds.coords:
-        x, y, r = (ds[f"contact_{n}"].values for n in ("x_mm", "y_mm", "radius_mm"))
-    else:
-        x, y, r = np.zeros(n_c), np.zeros(n_c), np.full(n_c, np.nan)
-    r = np.where(np.isfinite(r), r, np.inf)  # no contact: the force acts on the whole skin
-    region = np.array([str(region_at(a, b)) if np.isfinite(c) else "" for a, b, c in zip(x, y, r)], dtype=object)
-    return x, y, r, region, ds.fz.values[:, :, None]
-
-
-def _field_forces(ds, table) -> np.ndarray:
-    """(condition, time, electrode): the normal force under each field, N."""
-    x, y, r, region, forces = _sites_of(ds)
-    if "site" in ds.dims:
-        weights = field_weights(table, x, y, r, region)
-        return np.einsum("cts,es->cte", forces, weights)
-    out = np.empty((forces.shape[0], forces.shape[1], len(table)))
-    for c in range(forces.shape[0]):
-        out[c] = forces[c] * field_weights(table, x[c:c + 1], y[c:c + 1], r[c:c + 1], region[c:c + 1])[:, 0]
-    return out
+    contact = ([ds[f"contact_{n}"].values for n in ("x_mm", "y_mm", "radius_mm")] if "contact_radius_mm" in ds.coords
+               else [np.zeros(n_c), np.zeros(n_c), np.full(n_c, np.nan)])  # no contact: the whole skin
+    weights = np.stack([contact_weights(table, *(float(v[c]) for v in contact)) for c in range(n_c)])
+    return ds.fz.values[:, :, None] * weights[:, None, :]
 
 
 def stimulation_pulses(dataset, electrodes, rule="biomimetic") -> xr.Dataset:

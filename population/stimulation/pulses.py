@@ -28,7 +28,7 @@ import numpy as np
 
 from ddmm.models.metrics import CONTACT_THRESHOLD
 
-__all__ = ["PulseKernel", "field_weights", "disc_overlap"]
+__all__ = ["PulseKernel", "field_weights", "contact_weights", "disc_overlap"]
 
 
 def disc_overlap(d, r_field, r_site) -> np.ndarray:
@@ -65,6 +65,20 @@ def field_weights(table, x_mm, y_mm, radius_mm, region) -> np.ndarray:
         else:
             out[i, ~whole] = disc_overlap(np.hypot(x[~whole] - e.x_mm, y[~whole] - e.y_mm), e.radius_mm, r[~whole])
     return out
+
+
+def contact_weights(table, x_mm: float, y_mm: float, radius_mm: float) -> np.ndarray:
+    """(n_electrodes,): the share of one contact's force under each field.
+
+    The contact is a disc whose region is the hand-map region at its centre;
+    a radius that is NaN or None means no contact geometry: the force acts on
+    the whole skin, and every field takes all of it.
+    """
+    from ddmm.population.anatomy.hand_map import region_at
+
+    if radius_mm is None or not np.isfinite(radius_mm):
+        return field_weights(table, [0.0], [0.0], [np.inf], [""])[:, 0]
+    return field_weights(table, [x_mm], [y_mm], [radius_mm], [str(region_at(x_mm, y_mm))])[:, 0]
 
 
 def _csr(lists, n_items: int):

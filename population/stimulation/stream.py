@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ddmm.population.stimulation.encode import as_table
-from ddmm.population.stimulation.pulses import PulseKernel, field_weights
+from ddmm.population.stimulation.pulses import PulseKernel, contact_weights, field_weights
 from ddmm.population.stimulation.rules import get_rule
 
 __all__ = ["PulseEvents", "StimulationEncoder"]
@@ -84,15 +84,12 @@ class StimulationEncoder:
         self._width = self.table.column("phase_width_us")
 
     def _site_weights(self) -> np.ndarray:
-        from ddmm.population.anatomy.hand_map import region_at
-
         sites, contact = self.encoder.sites, self.encoder.contact
         if sites is not None:
             return field_weights(self.table, sites.x_mm, sites.y_mm, sites.radius_mm, sites.region)
         if contact is not None:
-            return field_weights(self.table, [contact.x_mm], [contact.y_mm], [contact.radius_mm],
-                                 [str(region_at(contact.x_mm, contact.y_mm))])
-        return field_weights(self.table, [0.0], [0.0], [np.inf], [""])
+            return contact_weights(self.table, contact.x_mm, contact.y_mm, contact.radius_mm)[:, None]
+        return contact_weights(self.table, 0.0, 0.0, None)[:, None]
 
     def warm_up(self) -> None:
         """`Encoder.warm_up` and one pass of the pulse kernel, then reset: before the first live sample."""
