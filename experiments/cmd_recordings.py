@@ -9,6 +9,8 @@ _FIELDS = ("time", "fx", "fy", "fz")
 # the single-site CSV reader's options and their defaults (a sensor-array file states its own)
 _CSV_ONLY = {"columns": None, "fs": None, "time_scale": 1.0, "negative_fz": "error", "gaps": "error",
              "units": "N", "fz_sign": 1}
+# Conditioning field -> option attribute
+_CONDITIONING = {"noise_n": "sensor_noise", "bandwidth_hz": "bandwidth", "shear_hold_n": "shear_hold"}
 
 
 def add_recording_options(p, *, stream: bool = False) -> None:
@@ -37,6 +39,9 @@ def add_recording_options(p, *, stream: bool = False) -> None:
     g.add_argument("--sensor-noise", type=float, default=None, metavar="N",
                    help="the sensor's noise SD in newtons: the fast band is gated at 4x it (default 0.02; 0: off)")
     g.add_argument("--bandwidth", type=float, default=None, metavar="HZ", help="the sensor's bandwidth in Hz")
+    g.add_argument("--shear-hold", type=float, default=None, metavar="N",
+                   help="the shear hold's width in newtons: tangential force moves only beyond +- it "
+                        "(default 0.025; 0: off)")
 
 
 def conditioning_from_args(args):
@@ -44,16 +49,12 @@ def conditioning_from_args(args):
     from ddmm.population.stimuli.conditioning import Conditioning
 
     if args.conditioning == "off":
-        if args.sensor_noise is not None or args.bandwidth is not None:
-            raise ValueError("--sensor-noise and --bandwidth set the conditioning, which --conditioning off "
-                             "switches off")
+        if any(getattr(args, name) is not None for name in _CONDITIONING.values()):
+            raise ValueError("--sensor-noise, --bandwidth and --shear-hold set the conditioning, which "
+                             "--conditioning off switches off")
         return None
-    settings = {"mode": args.conditioning}
-    if args.sensor_noise is not None:
-        settings["noise_n"] = args.sensor_noise
-    if args.bandwidth is not None:
-        settings["bandwidth_hz"] = args.bandwidth
-    return Conditioning(**settings)
+    settings = {field: getattr(args, name) for field, name in _CONDITIONING.items() if getattr(args, name) is not None}
+    return Conditioning(mode=args.conditioning, **settings)
 
 
 def refuse_csv_options(args, scene: str) -> None:

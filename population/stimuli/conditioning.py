@@ -21,7 +21,16 @@ it, so a stream and an offline run give the same numbers, bit for bit):
    the fast band, is removed, on a hold and during a ramp alike; a ramp's
    corners and a vibration larger than the threshold pass, smaller by the
    threshold.
-3. **Contact and shear**: contact starts when the gated F_Z rises above
+3. **Shear hold** (``shear_hold_n`` > 0): the kept band's tangential force
+   moves only when it leaves a band of +-``shear_hold_n`` around its last
+   value (a play operator, `hold_band`), and re-centres on the input at
+   0.5 Hz, so a hold is not left a width short.  On a sheared hold the slow band
+   still carries smoothed noise (at 100 Hz, ten times more per hertz than at
+   1 kHz for the same per-sample SD), and the shear term of the presets
+   multiplies it into FA-I's drive; held, the shear drifts at ~0.01 N/s.  A
+   ramp passes with its slope, at most ``shear_hold_n`` behind.  The width is the same at
+   every sample rate, so its lag is too.
+4. **Contact and shear**: contact starts when the gated F_Z rises above
    ``contact_on_n`` and ends when it falls below ``contact_off_n``
    (hysteresis); F_Z becomes ``max(F_Z - contact_on_n, 0)`` (continuous, so a
    contact onset is no force step), and out of contact the shear is zero.  In
@@ -30,8 +39,9 @@ it, so a stream and an offline run give the same numbers, bit for bit):
    its direction.
 
 ``mode="zero_phase"`` (offline only) resamples by monotone cubic
-interpolation and runs both filters forwards and backwards: no lag, but not
-causal, so a stream cannot reproduce it.
+interpolation, runs both filters forwards and backwards and averages the
+shear hold run both ways: no lag, but not causal, so a stream cannot
+reproduce it.
 """
 
 from __future__ import annotations
@@ -42,6 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ddmm.models._validation import as_finite_array, check_positive
+from ddmm.population.stimuli._conditioning_kernels import gate_hold_contact, hold_band, hold_counts, sos_filter
 
 __all__ = ["Conditioning", "Conditioner", "condition_forces", "noise_allowance", "CONDITIONING_MODES"]
 
@@ -49,6 +60,9 @@ CONDITIONING_MODES = ("causal", "zero_phase")
 _ORDER = 2  # the low-passes: 2nd-order Butterworth
 _GATE = 4.0  # the fast band's threshold, in multiples of noise_n: 3 left FA-II 3 pulses/s in a hold
 _SMOOTH = 2.0  # the slow band's smoothing low-pass, in multiples of slow_hz
+# The shear hold re-centres at 0.5 Hz: a step of shear is not left a width short, and the drift it lets
+# through moves at ~0.01 N/s, two hundred times below FA-I's velocity dead zone.
+_RECENTRE_HZ = 0.5
 
 
 @dataclass(frozen=True)
@@ -70,6 +84,12 @@ class Conditioning:
         Contact hysteresis thresholds on the gated F_Z, newtons (on > off).
     shear_deadband_n : float
         Tangential magnitude taken off in contact, newtons.
+    shear_hold_n : float
+        Width of the shear hold, newtons: the kept band's tangential force
+        moves only when the input leaves +- this around it (a play
+        operator), so noise on a sheared hold cannot wobble the shear.  0
+        turns it off.  Default 0.025 N (docs/recordings.md gives the
+        measurement).
     mode : {"causal", "zero_phase"}
         Causal filters (offline and streaming) or forward-backward ones
         (offline only).
@@ -81,10 +101,11 @@ class Conditioning:
     contact_on_n: float = 0.03
     contact_off_n: float = 0.015
     shear_deadband_n: float = 0.03
+    shear_hold_n: float = 0.025
     mode: str = "causal"
 
     def __post_init__(self):
-        for name in ("noise_n", "contact_off_n", "shear_deadband_n"):
+        for name in ("noise_n", "contact_off_n", "shear_deadband_n", "shear_hold_n"):
             _check_number(getattr(self, name), name, lambda x: x >= 0.0, ">= 0 (N)")
         _check_number(self.slow_hz, "slow_hz", lambda x: x > 0.0, "> 0 (Hz)")
         _check_number(self.contact_on_n, "contact_on_n", lambda x: x > self.contact_off_n,
@@ -168,7 +189,8 @@ class Conditioner:
         self._sos_smooth = _lowpass(min(_SMOOTH * conditioning.slow_hz, 0.45 * self.fs_out), self.fs_out)
         self._k = 0  # input samples consumed
         self._zi_rate = self._zi_slow = self._zi_smooth = None
-        self._contact = None
+        self._contact = self._held = None
+        self._alpha = 1.0 - math.exp(-2.0 * math.pi * _RECENTRE_HZ / self.fs_out)
 
     def _shape(self, forces):
         forces = as_finite_array(forces, "forces")
@@ -176,12 +198,6 @@ class Conditioner:
         if forces.ndim != len(want) + 1 or forces.shape[1:] != want:
             raise ValueError(f"forces must have shape (n, {', '.join(map(str, want))}), got {forces.shape}")
         return forces.reshape(forces.shape[0], -1)
-
-    def _hold_counts(self, n: int) -> np.ndarray:
-        """Output samples each of the next ``n`` input samples covers (upsampling)."""
-        k = np.arange(self._k, self._k + n + 1, dtype=float)
-        edges = np.ceil(k * (self.fs_out / self.fs_in) - 1e-9).astype(np.int64)
-        return np.diff(edges)
 
     def _picks(self, n: int) -> np.ndarray:
         """Indices (within the next ``n`` input samples) of the inputs the output grid samples (downsampling)."""
@@ -191,18 +207,17 @@ class Conditioner:
         return np.floor(m * (self.fs_in / self.fs_out) + 1e-9).astype(np.int64) - self._k
 
     def _filter(self, sos, x, which):
-        from scipy.signal import sosfilt, sosfilt_zi
+        from scipy.signal import sosfilt_zi
 
         zi = getattr(self, which)
         if zi is None:  # start in the steady state of the first sample: an offset is not a step
-            zi = sosfilt_zi(sos)[:, :, None] * x[0][None, None, :]
-        y, zi = sosfilt(sos, x, axis=0, zi=zi)
-        setattr(self, which, zi)
-        return y
+            zi = np.ascontiguousarray(sosfilt_zi(sos)[:, :, None] * x[0][None, None, :])
+            setattr(self, which, zi)
+        return sos_filter(sos, np.ascontiguousarray(x), zi)
 
     def _resample(self, x):
         if self._up:
-            return self._filter(self._sos_rate, np.repeat(x, self._hold_counts(x.shape[0]), axis=0), "_zi_rate")
+            return self._filter(self._sos_rate, np.repeat(x, hold_counts(self._k, x.shape[0], self.fs_out / self.fs_in), axis=0), "_zi_rate")
         return self._filter(self._sos_rate, x, "_zi_rate")[self._picks(x.shape[0])]
 
     def push(self, forces):
@@ -217,43 +232,33 @@ class Conditioner:
             The contact state per output sample.
         """
         x = self._shape(forces)
-        if x.shape[0] == 0:
-            return self._out(np.empty((0, x.shape[1])), np.empty((0, x.shape[1] // 3), bool))
-        y = self._resample(x)
+        sites = x.shape[1] // 3
+        y = self._resample(x) if x.shape[0] else np.empty((0, x.shape[1]))
         self._k += x.shape[0]
         if y.shape[0] == 0:
-            return self._out(y, np.empty((0, x.shape[1] // 3), bool))
+            return self._out(y, np.empty((0, sites), bool))
         if self.settings.noise_n > 0:
             slow = self._filter(self._sos_slow, y, "_zi_slow")
-            y = self._filter(self._sos_smooth, slow, "_zi_smooth") + _shrink(y - slow, _GATE * self.settings.noise_n)
-        return self._out(*self._contact_and_shear(y))
+            kept, gate = self._filter(self._sos_smooth, slow, "_zi_smooth"), _GATE * self.settings.noise_n
+        else:
+            slow, kept, gate = y, y, -1.0
+        return self._out(*self._finish(y, slow, kept, gate, self.settings.shear_hold_n))
 
-    def _contact_and_shear(self, y):
-        s = self.settings
-        y = y.reshape(y.shape[0], -1, 3)
-        state = np.zeros(y.shape[1], bool) if self._contact is None else self._contact
-        contact = np.empty(y.shape[:2], bool)
-        for i in range(y.shape[0]):  # hysteresis: sequential by nature
-            state = np.where(state, y[i, :, 2] >= s.contact_off_n, y[i, :, 2] > s.contact_on_n)
-            contact[i] = state
-        self._contact = state
-        out = np.empty_like(y)
-        out[..., 2] = np.maximum(y[..., 2] - s.contact_on_n, 0.0)
-        magnitude = np.hypot(y[..., 0], y[..., 1])
-        keep = np.where(magnitude > s.shear_deadband_n, 1.0 - s.shear_deadband_n / np.maximum(magnitude, 1e-300), 0.0)
-        keep = np.where(contact, keep, 0.0)
-        out[..., 0], out[..., 1] = y[..., 0] * keep, y[..., 1] * keep
-        return out.reshape(y.shape[0], -1), contact
+    def _finish(self, y, slow, kept, gate, width):
+        """Gate, shear hold of ``width`` N, contact and deadband (`gate_hold_contact`), state carried over."""
+        s, sites = self.settings, y.shape[1] // 3
+        if self._contact is None:
+            self._contact = np.zeros(sites, bool)
+            self._held = np.ascontiguousarray(kept[0].reshape(sites, 3)[:, :2])
+        shape = (y.shape[0], sites, 3)
+        return gate_hold_contact(y.reshape(shape), slow.reshape(shape), kept.reshape(shape), gate,
+                                 width, self._alpha, self._held, s.contact_on_n, s.contact_off_n,
+                                 s.shear_deadband_n, self._contact)
 
     def _out(self, y, contact):
         if self.n_sites is None:
             return y.reshape(-1, 3), contact.reshape(-1)
         return y.reshape(-1, self.n_sites, 3), contact.reshape(-1, self.n_sites)
-
-
-def _shrink(fast, threshold):
-    """Soft threshold: ``sign(x) max(|x| - threshold, 0)``."""
-    return np.sign(fast) * np.maximum(np.abs(fast) - threshold, 0.0)
 
 
 def condition_forces(forces, fs_in: float, fs_out: float, conditioning: Conditioning | None = None):
@@ -301,7 +306,21 @@ def _zero_phase(forces, fs_in, fs_out, conditioning, n_sites):
     padlen = min(y.shape[0] - 1, 3 * (2 * _ORDER + 1))
     if conditioning.bandwidth_hz is not None and conditioning.bandwidth_hz < 0.45 * fs_out:
         y = sosfiltfilt(_lowpass(conditioning.bandwidth_hz, fs_out), y, axis=0, padlen=padlen)
+    slow, kept, gate = y, y, -1.0
     if conditioning.noise_n > 0:
         slow = sosfiltfilt(causal._sos_slow, y, axis=0, padlen=padlen)
-        y = sosfiltfilt(causal._sos_smooth, slow, axis=0, padlen=padlen) + _shrink(y - slow, _GATE * conditioning.noise_n)
-    return causal._out(*causal._contact_and_shear(y))
+        kept, gate = sosfiltfilt(causal._sos_smooth, slow, axis=0, padlen=padlen), _GATE * conditioning.noise_n
+    kept = _hold_both_ways(np.ascontiguousarray(kept), conditioning.shear_hold_n, causal._alpha)
+    return causal._out(*causal._finish(np.ascontiguousarray(y), np.ascontiguousarray(slow), kept, gate, 0.0))
+
+
+def _hold_both_ways(kept, width, alpha):
+    """The shear hold run forwards and backwards, averaged: no lag, constant on a hold, as the other filters here."""
+    if width <= 0.0 or kept.shape[0] == 0:
+        return kept
+    shape = (kept.shape[0], kept.shape[1] // 3, 3)
+    forward, backward = kept.reshape(shape).copy(), kept[::-1].reshape(shape).copy()
+    hold_band(forward, width, alpha, np.ascontiguousarray(forward[0, :, :2]))
+    hold_band(backward, width, alpha, np.ascontiguousarray(backward[0, :, :2]))
+    forward[..., :2] = 0.5 * (forward[..., :2] + backward[::-1, :, :2])
+    return forward.reshape(kept.shape)

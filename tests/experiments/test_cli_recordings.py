@@ -41,10 +41,21 @@ def test_columns_and_units_from_the_command_line(tmp_path, capsys):
         assert ds.sizes["spike"] > 100
 
 
+def test_the_shear_hold_option_reaches_the_conditioning():
+    from ddmm.experiments.cli import build_parser
+    from ddmm.experiments.cmd_recordings import conditioning_from_args
+
+    parse = build_parser().parse_args
+    assert conditioning_from_args(parse(["simulate", "--out", "x.nc", "--shear-hold", "0"])).shear_hold_n == 0.0
+    assert conditioning_from_args(parse(["simulate", "--out", "x.nc"])).shear_hold_n == 0.025
+
+
 @pytest.mark.parametrize(("extra", "match"), [
     (["--columns", "tme=Time"], "--columns: 'tme=Time' is not NAME=COLUMN"),
-    (["--conditioning", "off", "--sensor-noise", "0.01"], "--sensor-noise and --bandwidth set the conditioning"),
+    (["--conditioning", "off", "--sensor-noise", "0.01"], "--sensor-noise, --bandwidth and --shear-hold set the"),
+    (["--conditioning", "off", "--shear-hold", "0"], "--sensor-noise, --bandwidth and --shear-hold set the"),
     (["--sensor-noise", "-1"], "noise_n must be a finite number >= 0"),
+    (["--shear-hold", "-0.5"], "shear_hold_n must be a finite number >= 0 \\(N\\), got -0.5"),
     (["--fs", "100"], "has a time column: give recorded_fs \\(--fs\\) only for a file without one"),
     (["--theta-r", "90"], "--theta-r does not apply to the recorded scene '.*p.csv': the file gives the forces"),
 ])
