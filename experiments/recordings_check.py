@@ -8,7 +8,8 @@ Two profiles, labelled as docs/recordings.md labels them:
 * ``variant`` (**held out**, run only after the choice): press to 2 N at 15 N/s, 0.6 N of shear toward
   radial-proximal (225 deg), hold, faster release.
 
-Noise is white and Gaussian, the same SD on each axis at every sample rate (as a reader of the file sees it).
+Noise is white and Gaussian, the same SD on each axis at every sample rate (as a reader of the file sees it),
+and, for each profile, of the same density at every rate (a sensor read through an anti-aliasing filter).
 """
 
 from __future__ import annotations
@@ -65,18 +66,26 @@ def phase_rates(population, forces, fs: float, profile: str, conditioning) -> di
     return rates
 
 
-def run_check(noise_levels=(0.0, 0.005, 0.01, 0.02), seed: int = 0) -> dict:
-    """Rates at every sample rate and noise level, and the worst ratio across rates per noise level."""
+def run_check(noise_levels=(0.0, 0.005, 0.01, 0.02), density_n: float = 0.02, seed: int = 0) -> dict:
+    """Rates at every sample rate and noise level, and the worst ratio across rates per noise level.
+
+    Each noise level is the same per-sample SD at every rate; ``density_n`` adds, per profile, noise of
+    the same *density* as ``density_n`` at 1 kHz (SD ``density_n sqrt(fs / 1 kHz)``): one sensor read
+    at each rate through an anti-aliasing filter.
+    """
     from ddmm.population import sample_population
     from ddmm.population.stimuli.conditioning import Conditioning
 
     pop = sample_population("fingertip", rng=seed)
     result = {}
     for profile, (_, role) in PROFILES.items():
-        for noise in noise_levels:
-            rates = {fs: phase_rates(pop, recording(profile, fs, noise, seed), fs, profile, Conditioning())
+        sds = {f"{profile} {noise:g} N": {fs: noise for fs in RATES_HZ} for noise in noise_levels}
+        sds[f"{profile} {density_n:g} N at 1 kHz, same density"] = {
+            fs: density_n * float(np.sqrt(fs / 1000.0)) for fs in RATES_HZ}
+        for name, sd in sds.items():
+            rates = {fs: phase_rates(pop, recording(profile, fs, sd[fs], seed), fs, profile, Conditioning())
                      for fs in RATES_HZ}
-            result[f"{profile} {noise:g} N"] = {"role": role, "rates": rates, "worst_ratio": _worst(rates)}
+            result[name] = {"role": role, "rates": rates, "worst_ratio": _worst(rates)}
     return result
 
 
