@@ -369,7 +369,7 @@ def press_push_lift(theta_r: float = 90.0, *, press_n: float = 3.0, push_n: floa
       into that ramp to its end, hold.  The default shear is
       ``push_n * tan 20 deg`` (about 2.18 N), Birznieks' inclination.
     * Stage 3 (25-30 s): ramp everything to 0 over ``lift_ramp_s`` (default
-      ``ramp_s``; at most 5 s), rest.
+      ``ramp_s``; at most 5 s, which leaves no static period), rest.
 
     Each stage is a dynamic period (D, the ramp) then a static one (S).  The
     paper gives neither ramp length nor the shear's onset: they are
@@ -397,7 +397,7 @@ def press_push_lift(theta_r: float = 90.0, *, press_n: float = 3.0, push_n: floa
             ("stage1_dynamic", 5.0, 5.0 + ramp_s), ("stage1_static", 5.0 + ramp_s, 15.0),
             ("stage2_dynamic", 15.0, 15.0 + ramp_s), ("stage2_static", 15.0 + ramp_s, 25.0),
             ("stage3_dynamic", 25.0, 25.0 + lift_s), ("stage3_static", 25.0 + lift_s, 30.0),
-        )
+        ) if a < b  # a 5 s lift leaves no static period
     )
     return Scene(shear * np.cos(rad), shear * np.sin(rad), fz, fs, f"press_push_lift_{theta_r:g}",
                  stages, contact, theta_r)

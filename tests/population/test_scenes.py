@@ -94,6 +94,12 @@ def test_reproduction_scene_ramps_and_shear_onset():
     np.testing.assert_array_equal(press_push_lift().fy, press_push_lift(shear_delay_s=0.0, lift_ramp_s=2.0).fy)
 
 
+def test_a_five_second_lift_leaves_no_static_stage():
+    """The longest lift the scene allows (the paper calibration's search reaches it) ends with the scene."""
+    s = press_push_lift(90.0, lift_ramp_s=5.0)
+    assert [st.label for st in s.stages][-1] == "stage3_dynamic" and s.stages[-1].end == 30.0
+
+
 @pytest.mark.parametrize("kwargs,match", [
     ({"shear_delay_s": 2.0}, r"shear_delay_s must be in \[0, ramp_s = 2\) s, got 2.0"),
     ({"shear_delay_s": -0.1}, "shear_delay_s must be in"),
