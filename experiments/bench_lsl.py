@@ -70,12 +70,16 @@ def _in_process(pop, forces):
 
 
 def _reader(inlet, arrivals, stop):
+    """Note each chunk of spikes with its arrival: a reader that allocates nothing per pull, as the bridge's."""
     import pylsl
 
+    from ddmm.population.runtime.lsl import ChunkReader
+
+    reader = ChunkReader(inlet, 4096)
     while not stop.is_set():
-        _, stamps = inlet.pull_chunk(timeout=0.05, max_samples=100_000, min_samples=1, as_numpy=True)
+        _, stamps = reader.pull(0.05)
         if len(stamps):
-            arrivals.append((pylsl.local_clock(), np.asarray(stamps)))
+            arrivals.append((pylsl.local_clock(), stamps.copy()))  # the reader's buffer is reused
 
 
 def _over_lsl(population: str, forces):

@@ -41,7 +41,7 @@ from ddmm.population._extras import require
 from ddmm.population.stimuli.recordings import UNITS
 
 __all__ = ["SPIKE_STREAM_TYPE", "FORCE_STREAM_TYPE", "PULSE_STREAM_TYPE", "ForceStream", "SpikeOutlet", "PulseOutlet",
-           "open_force_stream",
+           "ChunkReader", "open_force_stream",
            "open_force_outlet", "read_spike_metadata", "lsl_clock"]
 
 SPIKE_STREAM_TYPE = "Spikes"
@@ -276,6 +276,62 @@ def open_force_outlet(name: str, *, fs: float, n_sites: int = 1, units: str = "N
     return pylsl.StreamOutlet(info)
 
 
+class ChunkReader:
+    """Pull an inlet's samples as they come, into buffers kept between pulls.
+
+    ``pull(timeout)`` waits up to ``timeout`` s for a first sample, then
+    takes whatever else has arrived, up to ``max_samples``, without waiting
+    for more (liblsl's own chunk pull waits for a full buffer).  Unlike
+    pylsl's ``pull_chunk(min_samples=1)``, it allocates nothing per pull.
+
+    Parameters
+    ----------
+    inlet : pylsl.StreamInlet
+        An inlet on a numeric stream.
+    max_samples : int
+        The most samples one pull returns.
+
+    Examples
+    --------
+    >>> reader = ChunkReader(inlet)  # doctest: +SKIP
+    >>> samples, stamps = reader.pull(0.05)  # views, valid until the next pull  # doctest: +SKIP
+    """
+
+    def __init__(self, inlet, max_samples: int = 1024):
+        self.inlet, self.max_samples = inlet, int(max_samples)
+        n_channels, dtype = int(inlet.channel_count), getattr(inlet, "np_dtype", None)
+        self._samples = np.empty((self.max_samples, n_channels), dtype=dtype)
+        self._stamps = np.empty(self.max_samples)
+        self._error, self._handle = ctypes.c_int(), _handle_error()
+        raw = getattr(inlet, "do_pull_chunk", None), getattr(inlet, "obj", None), self._handle, dtype
+        # The raw call fills numeric buffers; a string stream, or a pylsl without it, takes the public call.
+        self._raw = None if any(r is None for r in raw) or self.max_samples < 2 else raw[:2]
+        # One sample's place, and all the rest's, in the buffers: the two pulls' arguments, made once.
+        data, stamps, size = self._samples.ctypes.data, self._stamps.ctypes.data, self._samples.itemsize
+        self._first = (ctypes.c_void_p(data), ctypes.c_void_p(stamps), ctypes.c_size_t(n_channels),
+                       ctypes.c_size_t(1))
+        self._rest = (ctypes.c_void_p(data + n_channels * size), ctypes.c_void_p(stamps + self._stamps.itemsize),
+                      ctypes.c_size_t(n_channels * (self.max_samples - 1)), ctypes.c_size_t(self.max_samples - 1))
+        self._per_sample, self._none = n_channels, ctypes.c_double(0.0)
+
+    def pull(self, timeout: float):
+        """(samples, stamps) arrived by ``timeout`` s: views of the buffers, overwritten by the next pull.
+
+        Raises pylsl's ``LostError`` when the sender has gone.
+        """
+        if self._raw is None:
+            return self.inlet.pull_chunk(timeout=timeout, max_samples=self.max_samples, min_samples=1,
+                                         as_numpy=True)
+        pull, obj = self._raw
+        n = pull(obj, *self._first, ctypes.c_double(timeout), ctypes.byref(self._error))
+        self._handle(self._error)
+        if n:
+            n += pull(obj, *self._rest, self._none, ctypes.byref(self._error))
+            self._handle(self._error)
+        n //= self._per_sample
+        return self._samples[:n], self._stamps[:n]
+
+
 def _handle_error():
     try:
         from pylsl.util import handle_error
@@ -322,6 +378,9 @@ class SpikeOutlet:
         self._ids = encoder.population.afferent_id.astype(np.int32)
         # An irregular stream's buffer counts hundreds of samples: 360,000 spikes for a slow consumer.
         self._outlet = pylsl.StreamOutlet(info, max_buffered=3600)
+        push_n, handle = getattr(self._outlet, "do_push_chunk_n", None), _handle_error()
+        # Looked up once: a push is on the latency path, once per force sample.
+        self._push_n = None if push_n is None or handle is None else (push_n, self._outlet.obj, handle)
 
     def push(self, positions, stamps) -> None:
         """Send spikes: the afferents' positions in the encoder's population and their LSL stamps (s)."""
@@ -331,12 +390,12 @@ class SpikeOutlet:
         stamps = np.ascontiguousarray(stamps, dtype=np.float64)
         if stamps.shape != ids.shape:
             raise ValueError(f"stamps must have one entry per spike; got {stamps.size} for {ids.size}")
-        push_n, handle = getattr(self._outlet, "do_push_chunk_n", None), _handle_error()
-        if push_n is None or handle is None:  # another pylsl: its public call, which copies the stamps to a list
+        if self._push_n is None:  # another pylsl: its public call, which copies the stamps to a list
             self._outlet.push_chunk(ids[:, None], stamps.tolist())
             return
         # pylsl's own call on the arrays as they are: a burst of 10,000 spikes costs liblsl ~2 ms, the list 1 ms more
-        handle(push_n(self._outlet.obj, ctypes.c_void_p(ids.ctypes.data), ctypes.c_long(ids.size),
+        push_n, obj, handle = self._push_n
+        handle(push_n(obj, ctypes.c_void_p(ids.ctypes.data), ctypes.c_long(ids.size),
                       ctypes.c_void_p(stamps.ctypes.data), ctypes.c_int(1)))
 
     def have_consumers(self) -> bool:
@@ -345,6 +404,7 @@ class SpikeOutlet:
 
     def close(self) -> None:
         """Withdraw the stream (consumers see it end)."""
+        self._push_n = None  # holds the outlet's handle, which dies with it
         del self._outlet
 
 

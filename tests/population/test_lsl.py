@@ -14,8 +14,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ddmm.population import from_csv, sample_population, simulate
-from ddmm.population.runtime.lsl import (ForceStream, SpikeOutlet, open_force_outlet, open_force_stream,
-                                         read_spike_metadata)
+from ddmm.population.runtime.lsl import (ChunkReader, ForceStream, SpikeOutlet, open_force_outlet,
+                                         open_force_stream, read_spike_metadata)
 from ddmm.population.runtime.lsl_bridge import Bridge, check_stamps
 from ddmm.population.runtime.stream import Encoder
 
@@ -68,6 +68,19 @@ def test_check_stamps_keeps_increasing_stamps_and_measures_gaps():
     np.testing.assert_allclose(excess, [0, 0, 0, 0, 0.0011, 0], atol=1e-12)
     keep, excess = check_stamps([5.0, 5.0014], None, 1000.0)  # 1.4 periods: jitter, not a gap
     assert keep.all() and not excess.any()
+
+
+@settings(max_examples=200, deadline=None)
+@given(steps=st.lists(st.floats(-0.002, 0.004, allow_nan=False), min_size=1, max_size=6))
+def test_the_usual_chunk_test_agrees_with_the_stamp_rule(recording, steps):
+    """A chunk the bridge encodes without the rule is one the rule keeps whole with no gap, and vice versa."""
+    bridge = Bridge(Encoder(recording[0].select([0]), FS), _fake(), print)
+    stamps = 1.0 + np.cumsum(steps)
+    bridge._last = 1.0
+    keep, excess = check_stamps(stamps, 1.0, FS)
+    assert bridge._in_step(stamps) == bool(keep.all() and not excess.any())
+    bridge._last = None  # the first chunk always takes the rule's path (it sets the stamps' anchor)
+    assert not bridge._in_step(stamps)
 
 
 @settings(max_examples=8, deadline=None)
@@ -159,6 +172,39 @@ def _drain(inlet, until, expected=None):
         elif until():
             quiet += 1
     return np.concatenate(ids or [np.empty(0, np.int64)]), np.concatenate(stamps or [np.empty(0)])
+
+
+def test_chunk_reader_returns_what_has_arrived_in_order_up_to_its_size():
+    import pylsl
+
+    name = _name("reader")
+    outlet = open_force_outlet(name, fs=FS)
+    force = open_force_stream(name, timeout=5.0)
+    force.open()
+    reader = ChunkReader(force.inlet, max_samples=4)
+    sent = np.arange(30.0).reshape(10, 3)
+    stamps = pylsl.local_clock() + np.arange(10) / FS
+    outlet.push_chunk(sent, stamps.tolist())
+    got, got_stamps, deadline = [], [], time.monotonic() + 10.0
+    while sum(len(g) for g in got) < 10 and time.monotonic() < deadline:
+        samples, ts = reader.pull(0.2)
+        assert len(samples) == len(ts) <= 4
+        got.append(samples.copy())
+        got_stamps.append(ts.copy())
+    np.testing.assert_array_equal(np.concatenate(got), sent)
+    np.testing.assert_array_equal(np.concatenate(got_stamps), stamps)
+    assert len(reader.pull(0.0)[1]) == 0  # nothing waiting: no wait, nothing returned
+    force.close()
+
+
+def test_chunk_reader_falls_back_on_pylsl_public_pull():
+    class Inlet:  # a pylsl without the raw call
+        channel_count, np_dtype = 3, np.float64
+
+        def pull_chunk(self, timeout, max_samples, min_samples, as_numpy):
+            return np.zeros((1, 3)), np.array([timeout + max_samples + min_samples])
+
+    assert ChunkReader(Inlet(), 8).pull(0.5)[1].tolist() == [9.5]
 
 
 def test_spikes_over_lsl_equal_the_offline_run_of_the_recorded_scene(recording):
