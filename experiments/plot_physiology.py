@@ -70,9 +70,10 @@ def plot_frequency_tuning(data: dict) -> Figure:
         curve = np.asarray(curve, dtype=float)
         finite = np.isfinite(curve)
         ax.loglog(np.asarray(FREQUENCIES_HZ)[finite], curve[finite], "o-", color=_TYPE_COLOURS[kind], label=type_label(kind))
+    # the human best bands (docs/references.md row 8)
     ax.axvspan(8, 64, color=_TYPE_COLOURS["RAI"], alpha=0.1)
-    ax.axvspan(150, 400, color=_TYPE_COLOURS["RAII"], alpha=0.1)
-    ax.set_xlabel("frequency (Hz), 1 N preload")
+    ax.axvspan(200, 300, color=_TYPE_COLOURS["RAII"], alpha=0.1)
+    ax.set_xlabel("frequency (Hz), 1 N preload; shaded: the human best band")
     ax.set_ylabel("amplitude for 1 spike/cycle (N)")
     ax.legend()
     return fig

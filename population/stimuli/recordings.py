@@ -231,7 +231,7 @@ def warn_band(what: str, fs_in: float, stacklevel: int = 4) -> None:
     """Warn (`RecordingBandWarning`) when a recording at ``fs_in`` Hz cannot carry FA-II's band."""
     if fs_in < FA_II_MIN_FS:
         warnings.warn(RecordingBandWarning(
-            f"{what} is sampled at {fs_in:g} Hz and carries 0-{fs_in / 2:g} Hz: FA-II's band (120-300 Hz) is "
+            f"{what} is sampled at {fs_in:g} Hz and carries 0-{fs_in / 2:g} Hz: FA-II's band (up to 300 Hz) is "
             "missing, so FA-II respond only to its ramps (leave them out with types=...)"), stacklevel=stacklevel)
 
 

@@ -22,7 +22,7 @@ def test_spec_table_starts_from_the_types_paper_values():
     assert spec.neuron == {"RAII": NeuronParams(a=0.5, b=NEURON_PARAMS["RAII"].b, c=-65.0, d=100.0)}
     assert sample_population(spec, rng=0).neuron == spec.neuron
     # the presets keep the paper's neurons but FA-II's (a refractory period and a smaller D, docs/model.md)
-    assert load_spec("fingertip").neuron == {"RAII": NeuronParams(b=0.25, d=2.0, t_ref=0.002)}
+    assert load_spec("fingertip").neuron == {"RAII": NeuronParams(b=0.25, d=0.5, t_ref=0.002)}
 
 
 @pytest.mark.parametrize(("table", "match"), [

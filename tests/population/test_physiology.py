@@ -18,8 +18,11 @@ def test_every_property_has_a_reference_with_a_role():
     roles = {r.role for r in PHYSIOLOGY_REFERENCE.values()}
     assert roles == {"fitted", "constrained", "held out"}
     held_out = {n for n, r in PHYSIOLOGY_REFERENCE.items() if r.role == "held out"}
-    assert {"force_coding_SAI", "rate_coding_RAI", "best_frequency_RAI", "best_frequency_RAII",
+    assert {"force_coding_SAI", "rate_coding_RAI", "best_frequency_RAI",
             "latency_vs_count", "continuity", "tuned_SAII"} <= held_out
+    # FA-II's D and high-pass were set looking at its best frequency (docs/model.md): constrained, human range
+    best = PHYSIOLOGY_REFERENCE["best_frequency_RAII"]
+    assert (best.role, best.low, best.high) == ("constrained", 200.0, 300.0)
 
 
 def test_fingertip_seed_0_passes_every_property_but_its_two_known_shortfalls(fingertip):
