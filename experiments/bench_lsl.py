@@ -85,7 +85,8 @@ def _reader(inlet, arrivals, stop):
 def _over_lsl(population: str, forces):
     import pylsl
 
-    from ddmm.population.runtime.lsl import open_force_outlet, read_spike_metadata
+    from ddmm.population.runtime.lsl import open_force_outlet
+    from ddmm.population.runtime.lsl_outlets import read_spike_metadata
 
     names = f"bench-force-{uuid.uuid4().hex[:8]}", f"bench-spikes-{uuid.uuid4().hex[:8]}"
     outlet = open_force_outlet(names[0], fs=_FS)

@@ -210,7 +210,7 @@ def run(args) -> int:
 def _spike_sink(args, encoder, force):
     if args.lsl_out is None:
         return csv_sink(encoder, sys.stdout), None
-    from ddmm.population.runtime.lsl import SpikeOutlet
+    from ddmm.population.runtime.lsl_outlets import SpikeOutlet
 
     outlet = SpikeOutlet(args.lsl_out, encoder, force=force)
     print(f"ddmm: publishing spikes of {len(encoder.positions):,} afferents on LSL stream {args.lsl_out!r} "
@@ -222,7 +222,7 @@ def _stimulator(args, encoder):
     """The stimulation encoder and its pulse outlet (``--electrodes``), or (None, None)."""
     if args.electrodes is None:
         return None, None
-    from ddmm.population.runtime.lsl import PulseOutlet
+    from ddmm.population.runtime.lsl_outlets import PulseOutlet
     from ddmm.population.stimulation import StimulationEncoder, read_electrodes
 
     stimulator = StimulationEncoder(encoder, read_electrodes(args.electrodes), args.rule)

@@ -5,8 +5,9 @@
 - `stream`: the streaming encoder (`Encoder`), live force in, spikes out;
 - `step_choice`: the (dt, method) that meets an accuracy tolerance;
 - `distributed`: a run's afferent blocks as Dask tasks;
-- `lsl`, `lsl_bridge`: Lab Streaming Layer streams (forces in, spikes out) and
-  the bridge between them and an `Encoder` (extra ``ddmm[lsl]``).
+- `lsl`, `lsl_outlets`, `lsl_bridge`: Lab Streaming Layer streams (forces in;
+  spikes and pulses out) and the bridge between them and an `Encoder` (extra
+  ``ddmm[lsl]``).
 """
 
 from ddmm.models._lazy import lazy_exports
@@ -17,8 +18,8 @@ _WHERE = {
     "stream": ("Encoder", "StreamSpikes"),
     "step_choice": ("choose_setting", "load_table"),
     "distributed": ("dask_client",),
-    "lsl": ("ForceStream", "SpikeOutlet", "open_force_stream", "open_force_outlet", "read_spike_metadata",
-            "lsl_clock"),
+    "lsl": ("ForceStream", "open_force_stream", "open_force_outlet", "lsl_clock"),
+    "lsl_outlets": ("SpikeOutlet", "PulseOutlet", "read_spike_metadata"),
     "lsl_bridge": ("Bridge", "BridgeSummary", "check_stamps", "play_forces"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

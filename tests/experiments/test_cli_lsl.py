@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 from ddmm.population import birznieks, sample_population
-from ddmm.population.runtime.lsl import open_force_outlet, read_spike_metadata
+from ddmm.population.runtime.lsl import open_force_outlet
+from ddmm.population.runtime.lsl_outlets import read_spike_metadata
 from ddmm.population.runtime.stream import Encoder
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "live-sensors.md"

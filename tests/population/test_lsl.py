@@ -14,8 +14,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ddmm.population import from_csv, sample_population, simulate
-from ddmm.population.runtime.lsl import (ChunkReader, ForceStream, SpikeOutlet, open_force_outlet,
-                                         open_force_stream, read_spike_metadata)
+from ddmm.population.runtime.lsl import ChunkReader, ForceStream, open_force_outlet, open_force_stream
+from ddmm.population.runtime.lsl_outlets import SpikeOutlet, read_spike_metadata
 from ddmm.population.runtime.lsl_bridge import Bridge, check_stamps
 from ddmm.population.runtime.stream import Encoder
 
@@ -288,7 +288,7 @@ def test_stimulation_pulses_over_lsl_equal_the_offline_stimulation_encoder(recor
     """--electrodes in closed loop: pulses on an LSL stream equal `StimulationEncoder` on the same samples."""
     import pylsl
 
-    from ddmm.population.runtime.lsl import PulseOutlet
+    from ddmm.population.runtime.lsl_outlets import PulseOutlet
     from ddmm.population.stimulation import Electrode, StimulationEncoder
 
     pop, raw, _, _ = recording
