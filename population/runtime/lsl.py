@@ -12,16 +12,7 @@ needs ``fs``).  Units are read from the XDF meta-data
 given as ``units``; channel labels that name axes (``Fx``, ``force_z``, ...)
 are checked to be in that order.  `open_force_stream` resolves it by name.
 
-**The spike stream** (`SpikeOutlet`): type ``Spikes``, one int32 channel,
-irregular rate; **one sample per spike, holding the afferent's id** (the
-``afferent`` coordinate of `simulate`'s Dataset), **stamped with the spike's
-time on the input stream's clock**: the capture stamp of the first force
-sample, mapped to this host's LSL clock, plus the spike's model time (a
-reported gap in the input moves the anchor by the gap's length,
-`ddmm.population.runtime.lsl_bridge`).  Spikes of one step go out in
-increasing id.  Its meta-data (`read_spike_metadata`) describe the
-population (id, type, position, region, theta_T and NAP of each afferent),
-the model settings and the input stream.
+**The spike stream** and its convention: `ddmm.population.runtime.lsl_outlets`.
 
 **A force outlet** for tests, demos and replaying recordings:
 `open_force_outlet`.
