@@ -57,6 +57,22 @@ def test_slip_detector_finds_slips_before_the_human_grip_response(small_pop):
     assert 0 < score["latency_ms"] < 74.0 / 2
 
 
+@pytest.mark.parametrize(("settle_s", "caught"), [(0.0, False), (0.05, True)])
+def test_the_slip_detector_waits_out_the_loading_onset_burst(small_pop, settle_s, caught):
+    """Every FA-I fires when tangential loading starts: watched from that moment, the burst sets the
+    threshold above the slips of a slow (2 N/s) load; watched from 50 ms on, every slip is caught."""
+    scenes = [incipient_slip(2.0, load_rate_n_s=rate, slip=s) for rate in (2.0, 8.0) for s in (True, False)]
+    ds = simulate(small_pop, scenes, engine="direct", trials=6, seed=2, quiet=True)
+    onset = np.array([sc.stages[2].start for sc in scenes])
+    slip = np.array([True, False, True, False])
+    train = ds.isel(spike=np.flatnonzero(ds.spike_trial.values < 3), trial=[0, 1, 2])
+    detector = SlipDetector(0.01, settle_s=settle_s).fit(train, slip, np.arange(ds.sizes["afferent"]), onset)
+    score = evaluate_slip(detector.detect(ds), slip, onset, ds.duration.values)
+    assert (score["accuracy"] == 1.0) is caught, score
+    with pytest.raises(ValueError, match="settle_s must be >= 0"):
+        SlipDetector(settle_s=-0.01)
+
+
 def test_evaluate_slip_counts_early_and_false_detections():
     times = np.array([[0.55, 0.4, np.inf], [np.inf, 0.2, np.inf]])
     score = evaluate_slip(times, [True, False], [0.5, 0.5], [1.0, 1.0])
