@@ -24,12 +24,12 @@ it, so a stream and an offline run give the same numbers, bit for bit):
 3. **Shear hold** (``shear_hold_n`` > 0): the kept band's tangential force
    moves only when it leaves a band of +-``shear_hold_n`` around its last
    value (a play operator, `hold_band`), and re-centres on the input at
-   0.5 Hz, so a hold is not left a width short.  On a sheared hold the slow band
-   still carries smoothed noise (at 100 Hz, ten times more per hertz than at
-   1 kHz for the same per-sample SD), and the shear term of the presets
-   multiplies it into FA-I's drive; held, the shear drifts at ~0.01 N/s.  A
-   ramp passes with its slope, at most ``shear_hold_n`` behind.  The width is the same at
-   every sample rate, so its lag is too.
+   0.5 Hz, so a hold is not left a width short.  On a sheared hold the slow
+   band still carries smoothed noise (at 100 Hz, ten times more per hertz
+   than at 1 kHz for the same per-sample SD), and the shear term of the
+   presets multiplies it into FA-I's drive; held, the shear drifts at
+   ~0.01 N/s.  A ramp passes with its slope, at most ``shear_hold_n``
+   behind.  The width is the same at every sample rate, so its lag is too.
 4. **Contact and shear**: contact starts when the gated F_Z rises above
    ``contact_on_n`` and ends when it falls below ``contact_off_n``
    (hysteresis); F_Z becomes ``max(F_Z - contact_on_n, 0)`` (continuous, so a
@@ -217,7 +217,8 @@ class Conditioner:
 
     def _resample(self, x):
         if self._up:
-            return self._filter(self._sos_rate, np.repeat(x, hold_counts(self._k, x.shape[0], self.fs_out / self.fs_in), axis=0), "_zi_rate")
+            held = np.repeat(x, hold_counts(self._k, x.shape[0], self.fs_out / self.fs_in), axis=0)
+            return self._filter(self._sos_rate, held, "_zi_rate")
         return self._filter(self._sos_rate, x, "_zi_rate")[self._picks(x.shape[0])]
 
     def push(self, forces):
