@@ -157,10 +157,16 @@ def _commands(code, e, force, rate, active_frac, limits, params, contact):
     span = (force - contact) / max(params[5] - contact, 1e-12)
     span = min(max(span, 0.0), 1.0)
     if code == 0:
-        return max_rate * min(rate / params[1], 1.0), a_min + (a_max - a_min) * min(active_frac / params[3], 1.0)
+        return max_rate * min(rate / params[1], 1.0), _between(a_min, a_max, min(active_frac / params[3], 1.0))
     if code == 1:
-        return min(params[4], max_rate), a_min + (a_max - a_min) * span
-    return max_rate * span, a_min + (a_max - a_min) * params[6]
+        return min(params[4], max_rate), _between(a_min, a_max, span)
+    return max_rate * span, _between(a_min, a_max, params[6])
+
+
+@nb.njit(cache=True, inline="always")
+def _between(a_min, a_max, x):
+    """``a_min + (a_max - a_min) x`` for x in [0, 1], never above ``a_max`` (the sum can round one ulp over)."""
+    return min(a_min + (a_max - a_min) * x, a_max)
 
 
 @nb.njit(cache=True)

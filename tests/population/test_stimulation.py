@@ -128,6 +128,18 @@ def test_every_limit_holds_for_random_tables_spikes_and_forces(table, rule, seed
     assert np.all(traces[0] <= table.column("max_rate_hz")) and np.all(traces[0] >= 0)  # the commands, too
 
 
+@pytest.mark.parametrize("code", [0, 1, 2])
+def test_a_full_amplitude_command_never_rounds_over_the_electrode_maximum(code):
+    """17.009 + (171.592 - 17.009) x 1 is 171.59200000000004 in floating point: the command must be 171.592.
+    (Found by the random multi-site test: 161.667 uA reported outside [33.025, 161.667].)"""
+    from ddmm.population.stimulation.pulses import _commands
+
+    limits = np.array([[17.009, 171.592, 200.0, 100.0]])
+    params = np.array([0.0, 1.0, 0.0, 0.5, 50.0, 1.0, 1.0])  # saturating rate, active fraction and force
+    _, amplitude = _commands(code, 0, 5.0, 10.0, 1.0, limits, params, CONTACT_THRESHOLD)
+    assert amplitude == 171.592
+
+
 def test_the_last_check_drops_a_pulse_closer_than_the_rate_limit_allows():
     """Even a command over the limit (which no rule gives) cannot place two pulses too close."""
     from ddmm.population.stimulation.pulses import _pulses
