@@ -4,7 +4,8 @@ conditioning stage and the fingertip preset: per-type rates per phase, silence i
 Two profiles, labelled as docs/recordings.md labels them:
 
 * ``press-push-lift`` (**constrained**): press to 3 N at 6 N/s, hold, push 1 N distal, hold, lift.  The
-  conditioning's gate (4 x ``noise_n``), tracker bandwidth (5 Hz) and smoothing (10 Hz) were chosen on it.
+  conditioning's gate (4 x ``noise_n``), tracker bandwidth (5 Hz, then 4 Hz) and smoothing (twice the
+  tracker's) were chosen on it; the 4 Hz and the shear hold looked at the variant too.
 * ``variant`` (**held out**, run only after the choice): press to 2 N at 15 N/s, 0.6 N of shear toward
   radial-proximal (225 deg), hold, faster release.
 

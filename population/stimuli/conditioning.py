@@ -76,7 +76,8 @@ class Conditioning:
         times it.  0 turns the gate off.  Default 0.02 N (covers 5-20 mN).
     slow_hz : float
         Bandwidth of the tracker that splits the slow band (kept) from the
-        fast band (gated), Hz.
+        fast band (gated), Hz.  Default 4 Hz (5 Hz let 10 mN of noise at
+        100 Hz move FA-I's ramp rates by 20%; docs/recordings.md).
     bandwidth_hz : float or None
         The sensor's bandwidth: a low-pass at this frequency, Hz (None: only
         the resampling filter, at 0.45 of the slower rate).
@@ -96,7 +97,7 @@ class Conditioning:
     """
 
     noise_n: float = 0.02
-    slow_hz: float = 5.0
+    slow_hz: float = 4.0
     bandwidth_hz: float | None = None
     contact_on_n: float = 0.03
     contact_off_n: float = 0.015
