@@ -16,7 +16,7 @@ _WHERE = {
     "decode": ("DECODERS", "FirstSpikeLatency", "MaximumLikelihood", "PopulationVector", "angular_error",
                "select_afferents", "window_responses"),
     "ml": ("ESTIMATORS", "FirstSpikeLatencyDecoder", "MaximumLikelihoodDecoder", "PopulationVectorDecoder",
-           "circular_score", "features"),
+           "circular_score", "example_features", "features"),
     "array_decode": ("CentroidClassifier", "SlipDetector", "evaluate_slip", "onset_counts", "stage_onset"),
     "physiology": ("PROPERTIES", "score_physiology", "summarise_scorecard"),
 }

@@ -48,7 +48,7 @@ from ddmm.population.analysis.decode import (
 )
 from ddmm.population.spec import NAP_CHOICES
 
-__all__ = ["features", "circular_score", "PopulationVectorDecoder", "MaximumLikelihoodDecoder",
+__all__ = ["features", "example_features", "circular_score", "PopulationVectorDecoder", "MaximumLikelihoodDecoder",
            "FirstSpikeLatencyDecoder", "ESTIMATORS", "expected_failed_checks"]
 
 KINDS = ("count", "latency")
@@ -127,6 +127,26 @@ def features(dataset: xr.Dataset, window_s: float = 0.125, *, start_s: float | N
         return rows, np.repeat(theta, n_t), np.tile(np.arange(n_t, dtype=np.int64), int(has.sum()))
     key = np.flatnonzero(has) if group_by == "condition" else np.unique(np.round(theta, 6), return_inverse=True)[1]
     return rows, np.repeat(theta, n_t), np.repeat(key, n_t).astype(np.int64)
+
+
+def example_features(kind: str = "count"):
+    """A small labelled set to try the decoders on: ``(dataset, X, y, groups)``.
+
+    Twelve selective afferents (SA-I, FA-I, SA-II, tuning angles every 30
+    deg, receptor noise) under Birznieks' protocol in 8 directions, 3 trials
+    each; `features` of the first 0.1 s (``kind`` as there).
+
+    Examples
+    --------
+    >>> ds, X, y, groups = example_features()
+    >>> X.shape, sorted(set(y.tolist()))[:3]
+    ((24, 12), [0.0, 45.0, 90.0])
+    """
+    from ddmm.population import birznieks, make_population, simulate
+
+    pop = make_population(["SAI", "RAI", "SAII"] * 4, theta_t=np.arange(0, 360, 30), nap="selective", noise_cv=0.3)
+    ds = simulate(pop, [birznieks(d) for d in range(0, 360, 45)], engine="direct", trials=3, quiet=True)
+    return (ds, *features(ds, 0.1, kind=kind))
 
 
 def _labelled_conditions(dataset: xr.Dataset, drop: bool) -> np.ndarray:
@@ -232,10 +252,7 @@ class PopulationVectorDecoder(_CircularDecoder):
 
     Examples
     --------
-    >>> from ddmm.population import birznieks, make_population, simulate
-    >>> pop = make_population(["SAI", "RAI", "SAII"] * 4, theta_t=np.arange(0, 360, 30), nap="selective", noise_cv=0.3)
-    >>> ds = simulate(pop, [birznieks(d) for d in range(0, 360, 45)], engine="direct", trials=3, quiet=True)
-    >>> X, y, groups = features(ds, 0.1)
+    >>> ds, X, y, groups = example_features()
     >>> est = PopulationVectorDecoder(theta_t=ds.theta_t.values, nap=ds.nap.values).fit(X, y)
     >>> bool(est.score(X, y) > 0.9), est.predict(X).shape
     (True, (24,))
@@ -288,10 +305,7 @@ class MaximumLikelihoodDecoder(_CircularDecoder):
 
     Examples
     --------
-    >>> from ddmm.population import birznieks, make_population, simulate
-    >>> pop = make_population(["SAI", "RAI", "SAII"] * 4, theta_t=np.arange(0, 360, 30), nap="selective", noise_cv=0.3)
-    >>> ds = simulate(pop, [birznieks(d) for d in range(0, 360, 45)], engine="direct", trials=3, quiet=True)
-    >>> X, y, groups = features(ds, 0.1)
+    >>> ds, X, y, groups = example_features()
     >>> est = MaximumLikelihoodDecoder(ridge=0.01).fit(X, y)
     >>> est.coef_.shape, bool(est.score(X, y) > 0.9)
     ((5, 12), True)
@@ -344,10 +358,7 @@ class FirstSpikeLatencyDecoder(_CircularDecoder):
 
     Examples
     --------
-    >>> from ddmm.population import birznieks, make_population, simulate
-    >>> pop = make_population(["SAI", "RAI", "SAII"] * 4, theta_t=np.arange(0, 360, 30), nap="selective", noise_cv=0.3)
-    >>> ds = simulate(pop, [birznieks(d) for d in range(0, 360, 45)], engine="direct", trials=3, quiet=True)
-    >>> X, y, groups = features(ds, 0.1, kind="latency")
+    >>> ds, X, y, groups = example_features(kind="latency")
     >>> est = FirstSpikeLatencyDecoder().fit(X, y)
     >>> est.usable_.shape, bool(est.score(X, y) > 0.9)
     ((12,), True)
