@@ -90,6 +90,7 @@ from ddmm.models._stage_kernels import (
     filter_sections,
     receptor_noise_keyed,
     stage_tail,
+    transduce_columns,
     transduce_inplace,
 )
 from ddmm.models.attenuation import UNTUNED
@@ -425,8 +426,11 @@ class FusedPipeline:
         # (numba's cache does not track a cached caller's parallel callee).
         drive = _front(*args) if bounds is None or bounds.size <= 2 else _front_parts(*args, bounds)
         excite = self.excitability(key) if noisy and self.excite_any else None
-        for cols, stage in self.transducers:
-            transduce_inplace(drive[:, cols], stage, None if excite is None else excite[cols])  # as `current_core`
+        for cols, stage in self.transducers:  # as `current_core`
+            if stage.signed:
+                transduce_inplace(drive[:, cols], stage, None if excite is None else excite[cols])
+            else:
+                transduce_columns(drive, cols, stage, None if excite is None else excite[cols])
         if excite is not None:
             for cols in self._plain:  # runs without a transducer: the factor alone
                 drive[:, cols] *= excite[cols]

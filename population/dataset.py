@@ -150,12 +150,16 @@ def _events(plan, spikes, n_conditions: int):
     afferent): the four event arrays and the spike counts per (condition, trial, afferent)."""
     remap = np.full(plan.selected.size, -1, np.int64)
     remap[plan.keep] = np.arange(plan.keep.size)
+    every = plan.keep.size == plan.selected.size  # the usual run keeps all it simulated: positions are final
     cols = [[], [], [], []]
     for c, parts in enumerate(spikes):
         for trial, pos, step in parts:
-            aff = remap[pos]
-            ok = aff >= 0
-            for col, arr in zip(cols, (np.full(ok.sum(), c), trial[ok], step[ok], aff[ok])):
+            aff = pos
+            if not every:
+                aff = remap[pos]
+                ok = aff >= 0
+                trial, step, aff = trial[ok], step[ok], aff[ok]
+            for col, arr in zip(cols, (np.full(aff.size, c), trial, step, aff)):
                 col.append(np.asarray(arr, np.int64))
     cond, trial, step, aff = (np.concatenate(c) if c else np.empty(0, np.int64) for c in cols)
     return _sorted_events(cond, trial, step, aff, n_conditions, plan.trials, plan.keep.size)

@@ -161,8 +161,15 @@ def _validate_values(pop: Population) -> None:
         raise ValueError("population gain, noise_sigma and noise_cv must be >= 0")
     for profile in PROFILE_NAMES:
         validate_k(pop.k[pop.nap == profile], profile)
-    if len(np.unique(pop.afferent_id)) != len(pop):
+    if _repeats(np.asarray(pop.afferent_id)):
         raise ValueError("population afferent_id values must be unique")
+
+
+def _repeats(ids) -> bool:
+    """Whether an id occurs twice: a histogram for the usual small non-negative ids, else a sort."""
+    if ids.size and ids.dtype.kind in "iu" and ids.min() >= 0 and ids.max() < 4 * ids.size + 1024:
+        return bool(np.bincount(ids).max() > 1)
+    return len(np.unique(ids)) != ids.size
 
 
 def _apportion(fractions: dict, n: int) -> list:
@@ -172,7 +179,7 @@ def _apportion(fractions: dict, n: int) -> list:
     counts = np.floor(raw).astype(int)
     order = np.argsort(-(raw - counts), kind="stable")
     counts[order[: n - counts.sum()]] += 1
-    return [k for k, c in zip(keys, counts) for _ in range(c)]
+    return np.repeat(np.array(keys, dtype=object), counts).tolist()
 
 
 def _sample_angles(dist: AngleDistribution, n: int, rng) -> np.ndarray:
@@ -212,13 +219,14 @@ def _place_in_ellipse(region, n: int, rng) -> dict:
 
 def _place_on_map(counts: dict, n: int, rng) -> dict:
     """Region by region (map order), uniform within each, hand frame."""
-    names = [name for name, c in counts.items() for _ in range(c)]
-    if len(names) != n:  # pragma: no cover - counts come from the same map
-        raise ValueError(f"map counts sum to {len(names)}, expected {n}")
+    sizes = np.array(list(counts.values()), dtype=np.int64)
+    if sizes.sum() != n:  # pragma: no cover - counts come from the same map
+        raise ValueError(f"map counts sum to {sizes.sum()}, expected {n}")
     pts = [hand_map.sample_in_region(name, c, rng) for name, c in counts.items()]
     xy = np.concatenate(pts) if pts else np.empty((0, 2))
-    return {"x_mm": xy[:, 0], "y_mm": xy[:, 1], "region": np.array(names, dtype=object).reshape(n),
-            "frame_deg": np.array([hand_map.REGIONS[r].frame_deg for r in names], float).reshape(n)}
+    frames = np.array([hand_map.REGIONS[name].frame_deg for name in counts], float)
+    return {"x_mm": xy[:, 0], "y_mm": xy[:, 1], "region": np.repeat(np.array(list(counts), dtype=object), sizes),
+            "frame_deg": np.repeat(frames, sizes)}
 
 
 def _sample_type(kind: str, spec: TypeSpec, n: int, place, rng) -> dict:

@@ -26,11 +26,11 @@ from __future__ import annotations
 
 import math
 import os
-from concurrent.futures import ThreadPoolExecutor
 
 import numba as nb
 import numpy as np
 
+from ddmm.models._executors import shared_executor
 from ddmm.models.neuron import refractory_steps
 
 __all__ = ["run_direct", "default_threads", "BLOCK", "METHOD_CODES", "integrate_range", "integrate_parts", "part_bounds",
@@ -268,14 +268,8 @@ def part_bounds(n_neurons: int, parts: int) -> np.ndarray:
     return bounds.astype(np.int64)
 
 
-_EXECUTOR: ThreadPoolExecutor | None = None
-
-
-def _executor(threads: int) -> ThreadPoolExecutor:
-    global _EXECUTOR
-    if _EXECUTOR is None or _EXECUTOR._max_workers != threads:
-        _EXECUTOR = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="ddmm-direct")
-    return _EXECUTOR
+def _executor(threads: int):
+    return shared_executor("direct", threads)
 
 
 def run_direct(current, substeps, dt, params, v, u, r=None, method="euler", v_peak=30.0, v_floor=-100.0,

@@ -200,14 +200,21 @@ def _quiet(pop, sel, scene, scale, af_stage, af_constant):
 
 def _excitable(pop, sel) -> np.ndarray:
     """Afferents whose type has a trial excitability (``excite_cv_<type>``): their current differs by trial."""
-    types = [t for t in AFFERENT_TYPES if pop.current.excite_cv(t) > 0]
-    return np.isin(pop.afferent_type[sel], types)
+    return _of_type(pop.afferent_type[sel], [t for t in AFFERENT_TYPES if pop.current.excite_cv(t) > 0])
+
+
+def _of_type(afferent_type, types) -> np.ndarray:
+    """Whether each afferent's type is one of ``types`` (one comparison a type: np.isin sorts the strings)."""
+    out = np.zeros(afferent_type.shape, dtype=bool)
+    for t in types:
+        out |= afferent_type == t
+    return out
 
 
 def _shear_gained(pop, sel):
     """Whether each afferent's drive has a shear-magnitude term (``CurrentParams.shear_<type>`` > 0)."""
-    gain = {t: pop.current.stage(t).shear if t != "SAII" else 0.0 for t in AFFERENT_TYPES}
-    return np.array([gain[t] > 0.0 for t in pop.afferent_type[sel]], dtype=bool)
+    gained = [t for t in AFFERENT_TYPES if t != "SAII" and pop.current.stage(t).shear > 0.0]
+    return _of_type(pop.afferent_type[sel], gained)
 
 
 def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
@@ -274,7 +281,7 @@ def make_plan(population, scenes, *, types=None, trials: int = 1, record=RECORD_
     requested = tuple(AFFERENT_TYPES) if types is None else tuple(normalize_type(t, "types") for t in types)
     for r in record:
         check_choice(r, "record", RECORD_CHOICES)
-    wanted = np.isin(population.afferent_type, requested)
+    wanted = _of_type(population.afferent_type, requested)
     selected = np.arange(len(population)) if not enabled else np.flatnonzero(wanted)
     keep = np.flatnonzero(wanted[selected])
     conds = tuple(_condition_plan(population, selected, s, no_shear, enabled) for s in scenes)

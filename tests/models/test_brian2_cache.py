@@ -39,7 +39,11 @@ def test_two_processes_building_into_one_empty_cache_both_succeed(tmp_path):
 
 
 @pytest.mark.parametrize("damage", ["truncate", "empty"])
-def test_a_damaged_binary_is_rebuilt_with_a_notice(capsys, monkeypatch, damage):
+def test_a_damaged_binary_is_rebuilt_with_a_notice(capsys, monkeypatch, damage, tmp_path):
+    # A cache of its own: damaging the shared one raced another test worker running that binary
+    # ("Exec format error: './main'").
+    monkeypatch.setenv("DDMM_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(engine, "_BUILDS", {})
     used = []
     activate = engine._activate
     monkeypatch.setattr(engine, "_activate", lambda key: used.append(activate(key)) or used[-1])

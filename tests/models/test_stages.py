@@ -144,3 +144,32 @@ def _signed_derivative(f, kind):
     y, _ = filter_force(f, FS, CurrentParams())
     d = np.diff(np.r_[y[:1], y], axis=0) * FS
     return (d if kind == "RAI" else np.diff(np.r_[d[:1], d], axis=0) * FS)[:, 0]
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), kind=st.sampled_from(("SAI", "RAI", "RAII")), excited=st.booleans(),
+       live=st.lists(st.booleans(), min_size=1, max_size=60), lo=st.integers(0, 3), width=st.integers(1, 6))
+def test_fused_transducer_equals_the_stage_transducer(seed, kind, excited, live, lo, width):
+    # `transduce_columns` (the fused pipeline's) against `transduce_inplace` (the stages'), bit for bit, on
+    # columns lo..lo+width of a drive whose rows are zero or not in any pattern (it skips all-zero rows).
+    from ddmm.models._stage_kernels import transduce_columns, transduce_inplace
+    from ddmm.models.currents import stage_constants
+
+    rng = np.random.default_rng(seed)
+    stage = stage_constants(PHYSIO, kind, FS)[0]
+    drive = np.abs(rng.normal(0.0, 50.0, (len(live), 10))) * np.asarray(live)[:, None]  # unsigned drive: >= 0
+    drive[rng.random(drive.shape) < 0.1] = -0.0
+    excite = rng.uniform(0.5, 1.5, width) if excited else None
+    cols = slice(lo, lo + width)
+    want = drive.copy()
+    transduce_inplace(want[:, cols], stage, excite)
+    got = transduce_columns(drive.copy(), cols, stage, excite)
+    np.testing.assert_array_equal(got.view(np.int64), want.view(np.int64))
+
+
+def test_fused_transducer_refuses_a_signed_stage():
+    from ddmm.models._stage_kernels import transduce_columns
+    from ddmm.models.currents import stage_constants
+
+    with pytest.raises(ValueError, match="unsigned"):
+        transduce_columns(np.zeros((3, 2)), slice(0, 2), stage_constants(PHYSIO, "SAII", FS)[0])
