@@ -103,6 +103,11 @@ from ddmm.models.rng import normal_row
 
 __all__ = ["FusedPipeline", "mix_forces", "mixing_matrix"]
 
+#: Rows (samples) of a drive from which the transducers run fused (`transduce_columns`): below, its
+#: per-call set-up costs more than numpy's few passes save (a streaming push is one row).
+_FUSED_ROWS = 64
+
+
 @nb.njit(cache=True, nogil=True)
 def _front(forces, sites, weights, mixed, key, noisy_any, ids, sample0, state, started, aff_f, grp_f, grp_i,
            sos, fs, smooth_reading, outside_value, f_th, opponent, normal, out):
@@ -426,8 +431,8 @@ class FusedPipeline:
         # (numba's cache does not track a cached caller's parallel callee).
         drive = _front(*args) if bounds is None or bounds.size <= 2 else _front_parts(*args, bounds)
         excite = self.excitability(key) if noisy and self.excite_any else None
-        for cols, stage in self.transducers:  # as `current_core`
-            if stage.signed:
+        for cols, stage in self.transducers:  # as `current_core`; a push of a few rows: numpy's passes cost least
+            if stage.signed or drive.shape[0] < _FUSED_ROWS:
                 transduce_inplace(drive[:, cols], stage, None if excite is None else excite[cols])
             else:
                 transduce_columns(drive, cols, stage, None if excite is None else excite[cols])
