@@ -193,8 +193,9 @@ def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, st
 
 
 @nb.njit(cache=True, nogil=True)
-def _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i, sigma_idx):
-    """Low-pass, bias and additive noise of the transduced drive, in place; returns the smallest current.
+def _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i, sigma_idx, track=True):
+    """Low-pass, bias and additive noise of the transduced drive, in place; returns the smallest current
+    (with ``track``; else inf).
 
     Additive noise is drawn for the afferents ``sigma_idx`` (those with
     sigma > 0) only: adding 0 * xi would leave every other current as it is.
@@ -226,8 +227,9 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i
             for k in range(sigma_idx.size):
                 j = sigma_idx[k]
                 current[i, j] = current[i, j] + xi[k] * aff_f[_SIGMA, j]  # `noise_current`
-        for j in range(current.shape[1]):
-            lowest = min(lowest, current[i, j])
+        if track:  # only an explicit method's stability check reads it
+            for j in range(current.shape[1]):
+                lowest = min(lowest, current[i, j])
     return lowest
 
 
@@ -236,11 +238,12 @@ def _back_and_integrate(current, key, additive, ids, sample0, state, rows, aff_f
                         substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor, block, integrate):
     """`_back`, then (if ``integrate``) the direct engine on the current.
 
-    Returns spikes, the smallest current, whether the state stayed finite and
-    whether a neuron spiked on consecutive steps (the one-spike-per-step cap
-    bound): the seam's checks need the full spike lists only then.
+    Returns spikes, the smallest current (inf for Euler, whose check does not
+    read it), whether the state stayed finite and whether a neuron spiked on
+    consecutive steps (the one-spike-per-step cap bound): the seam's checks
+    need the full spike lists only then.
     """
-    lowest = _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i, sigma_idx)
+    lowest = _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i, sigma_idx, method != 0)
     if not integrate:
         return np.empty(0, np.int64), np.empty(0, np.int64), lowest, True, False
     idx, stp = integrate_range(current, substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor, block,
@@ -334,7 +337,7 @@ class FusedPipeline:
         rad = np.deg2rad(np.asarray(theta_t, dtype=float))
         aff_f[_COS], aff_f[_SIN], aff_f[_K] = np.cos(rad), np.sin(rad), np.asarray(k, dtype=float)
         aff_f[_TIP] = 1.0
-        for name in np.unique(nap[tuned]):  # per profile, not per afferent (this runs once per block)
+        for name in sorted(set(nap[tuned].tolist())):  # per profile, not per afferent (this runs once per block)
             profile, rows = get_profile(str(name)), nap == name
             aff_f[_P1:_P5 + 1, rows] = np.array([profile.p1, profile.p2, profile.p3, profile.p4, profile.p5])[:, None]
             aff_f[_TIP, rows] = tip_radius(str(name))

@@ -124,3 +124,17 @@ def test_rotating_shear_and_tuning_together_leaves_spikes_unchanged(alpha, engin
 def test_identical_seeds_identical_datasets(engine, pop):
     a, b = (simulate(pop, birznieks(10.0), engine=engine, seed=8, trials=2, quiet=True) for _ in range(2))
     assert a.identical(b)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_multistage_method_refuses_a_negative_drive_from_the_pipeline(engine):
+    # SA-II stretched against its preferred direction (opponent 1): -30 mV/ms, a 60 mV step at dt = 2 ms.
+    # The fused pipeline's smallest current feeds the check; Euler is floored and runs.
+    from ddmm.models.currents import CurrentParams
+    from ddmm.models.engines import NumericalInstabilityError
+
+    pop = make_population(["SAII"], theta_t=0.0, nap="selective", current=CurrentParams(opponent_saii=1.0, g_saii=10.0))
+    scene = Scene(np.full(50, -5.0), np.zeros(50), np.full(50, 1.0), fs=500.0)
+    with pytest.raises(NumericalInstabilityError, match="unstable for currents down to -30 mV/ms"):
+        simulate(pop, scene, engine=engine, dt=2e-3, method="rk4", seed=0, quiet=True)
+    assert finite(simulate(pop, scene, engine=engine, dt=2e-3, method="euler", seed=0, quiet=True))
