@@ -46,3 +46,21 @@ def test_absurd_counts_and_steps_are_refused():
     with pytest.raises(ValueError, match=r"dt must be >= 1e-06 s"):
         simulate(pop, birznieks(90.0), engine="direct", dt=1e-9, quiet=True)
     assert np.isfinite(available_bytes())
+
+
+def _sum_on_the_shared_pool():
+    from ddmm.models._executors import shared_executor
+
+    return shared_executor("test-fork", 1).submit(sum, [1, 2]).result(timeout=10)
+
+
+def test_a_forked_child_gets_a_pool_of_its_own():
+    # A forked child inherits the pool object but not its threads: without a new pool, its work would
+    # wait forever (here: the 10 s timeout).
+    import multiprocessing
+
+    from ddmm.models._executors import shared_executor
+
+    assert shared_executor("test-fork", 1).submit(sum, [2, 2]).result() == 4  # the parent's pool exists
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        assert pool.apply_async(_sum_on_the_shared_pool).get(timeout=30) == 3
