@@ -205,8 +205,6 @@ def transduce_inplace(drive, stage, excite=None):
     return drive
 
 
-
-
 #: Zero rows between two live runs that `transduce_columns` still passes to numpy in one call (a zero row maps
 #: to itself through every step, so this changes no bit; it saves numpy's per-call cost on scattered rows).
 _ROW_GAP = 16
