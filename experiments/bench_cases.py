@@ -77,9 +77,9 @@ def run_case(name: str) -> dict:
     """
     population, engine, sim_s, warm = CASES[name]
     for _ in range(WARMUPS if warm else 0):
-        _pipeline(population, engine, sim_s)
+        n = _pipeline(population, engine, sim_s)[0]
     if name == "hand_1s_direct":
-        return _against_kernel(name, population, engine, sim_s)
+        return _against_kernel(name, population, engine, sim_s, n)
     wall, (n, ds) = _median_wall(lambda: _pipeline(population, engine, sim_s), REPEATS if warm else 1)
     return _case_result(name, engine, n, sim_s, wall, ds, REPEATS if warm else 1)
 
@@ -91,13 +91,12 @@ def _case_result(name, engine, n, sim_s, wall, ds, runs) -> dict:
             "spikes": int(ds.sizes["spike"]), "timed_runs": runs}
 
 
-def _against_kernel(name, population, engine, sim_s) -> dict:
+def _against_kernel(name, population, engine, sim_s, n) -> dict:
     """A warm case timed in turn with the integration kernel alone, run by run (pipeline, kernel,
     pipeline, ...): the pipeline over the kernel is the median of the pairs' ratios, so a host's
     drift during the case moves both sides of each ratio alike."""
     import statistics
 
-    n = _pipeline(population, engine, sim_s)[0]
     kernel = _kernel_alone(n, sim_s)
     kernel()  # warm-up: kernels, thread pool, spike buffers
     walls, kernels = [], []

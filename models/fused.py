@@ -473,7 +473,7 @@ class FusedPipeline:
     def _current_slice(self, forces, state, started, sample0, key, out=None):
         current = self._drive(forces, state, started, sample0, key, out=out)
         _back(current, np.uint64(key or 0), key is not None and self.additive, self.afferent_id, int(sample0), state,
-              self.rows, self.aff_f, self.grp_f, self.grp_i, self.sigma_idx)
+              self.rows, self.aff_f, self.grp_f, self.grp_i, self.sigma_idx, False)  # the engines check currents
         return current
 
     def spikes(self, forces, state, started, sample0, key, neuron, v, u, parts=1, r=None):

@@ -268,10 +268,6 @@ def part_bounds(n_neurons: int, parts: int) -> np.ndarray:
     return bounds.astype(np.int64)
 
 
-def _executor(threads: int):
-    return shared_executor("direct", threads)
-
-
 def run_direct(current, substeps, dt, params, v, u, r=None, method="euler", v_peak=30.0, v_floor=-100.0,
                threads=None):
     """Integrate eqs 4-6 for N neurons with the direct engine.
@@ -327,7 +323,7 @@ def run_direct(current, substeps, dt, params, v, u, r=None, method="euler", v_pe
     if len(ranges) == 1:
         parts = [work(*ranges[0])]
     else:
-        parts = list(_executor(threads).map(lambda r: work(*r), ranges))
+        parts = list(shared_executor("direct", threads).map(lambda r: work(*r), ranges))
     neuron = np.concatenate([p[0] for p in parts]) if parts else np.empty(0, np.int64)
     step = np.concatenate([p[1] for p in parts]) if parts else np.empty(0, np.int64)
     order = np.lexsort((neuron, step))
