@@ -7,7 +7,7 @@ import json
 import os
 from pathlib import Path
 
-from ddmm.population.io._files import atomic_write
+from ddmm.utils.files import atomic_write
 
 __all__ = ["ensure_out_dir", "atomic_write", "save_figure", "save_json", "seed_arg"]
 

@@ -19,7 +19,7 @@ Names are imported on first use (PEP 562): ``import ddmm.models`` loads
 nothing heavy until a name is touched.
 """
 
-from ._lazy import lazy_exports
+from ddmm.utils.lazy import lazy_exports
 
 _WHERE = {
     "attenuation": ("F_TH", "UNTUNED", "attenuated_force", "attenuation_factor", "shear_magnitude"),

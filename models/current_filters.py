@@ -18,9 +18,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from ddmm.models._cache import cache_root
+from ddmm.utils.cache import cache_root
 from ddmm.models._stage_kernels import stage_kernel
-from ddmm.models._validation import as_finite_array, check_positive
+from ddmm.utils.validation import as_finite_array, check_positive
 from ddmm.models.afferent_types import AFFERENT_TYPES
 from ddmm.models.current_params import CurrentParams, CurrentStage
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models._validation import check_positive, shown
+from ddmm.utils.validation import check_positive, shown
 from ddmm.models.afferent_types import normalize_type
 
 __all__ = ["DERIVATIVE_ORDER", "CurrentParams", "CurrentStage"]
@@ -35,7 +35,7 @@ class CurrentParams:
 
     The defaults are the paper's eqs 1-3, with gains calibrated so that the
     CMM (AF = 1) press-push-lift response lies near paper Table III (SAI
-    about 47.5 pulses/s, RAI and RAII 10-20); ``experiments/calibrate_core.py``
+    about 47.5 pulses/s, RAI and RAII 10-20); ``experiments/calibration/gains.py``
     reproduces the fit.  Fields marked *ours* are off (None or 0) by default.
 
     Attributes

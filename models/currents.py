@@ -76,7 +76,7 @@ from __future__ import annotations
 import numpy as np
 
 from ddmm.models._stage_kernels import dynamic_kernel, smooth_kernel, stage_kernel, transduce_inplace
-from ddmm.models._validation import as_finite_array, check_positive
+from ddmm.utils.validation import as_finite_array, check_positive
 from ddmm.models.afferent_types import AFFERENT_TYPES, PAPER_TYPES, TYPE_LABELS, normalize_type, type_label
 from ddmm.models.current_filters import (
     _NO_NORMALS,

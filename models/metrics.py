@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models._validation import as_finite_array, check_positive
+from ddmm.utils.validation import as_finite_array, check_positive
 
 __all__ = ["CONTACT_THRESHOLD", "SF_DEFINITIONS", "active_mask", "spiking_frequency", "direction_index"]
 

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models._validation import shown
+from ddmm.utils.validation import shown
 
 from ddmm.models.currents import AFFERENT_TYPES, normalize_type
 

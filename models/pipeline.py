@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models._validation import check_forces, check_positive
+from ddmm.utils.validation import check_forces, check_positive
 from ddmm.models.afferent_types import AFFERENT_TYPES
 from ddmm.models.attenuation import (
     F_TH,

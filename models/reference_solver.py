@@ -17,7 +17,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from ddmm.models._validation import shown
+from ddmm.utils.validation import shown
 
 from ddmm.models.neuron import V_PEAK
 

@@ -23,7 +23,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ddmm.models._validation import shown
+from ddmm.utils.validation import shown
 
 __all__ = ["philox4x32", "stream_key", "normal", "normal_row", "normals"]
 

@@ -22,7 +22,7 @@ costs only what a caller touches: no xarray before a dataset is built, no
 scipy before a filter is designed.
 """
 
-from ddmm.models._lazy import lazy_exports
+from ddmm.utils.lazy import lazy_exports
 
 _WHERE = {
     "io.arrays": ("from_array", "from_long_csv", "save_array"),

@@ -36,14 +36,14 @@ from pathlib import Path
 import numba as nb
 import numpy as np
 
-from ddmm.models._validation import shown
+from ddmm.utils.validation import shown
 import xarray as xr
 
 from ddmm.models.attenuation import F_TH
 from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.models.neuron import NEURON_PARAMS, V_PEAK
 from ddmm.population.anatomy.receptive_fields import RF_SIGMA_MM, RF_SUPPORT
-from ddmm.population.io._files import read_netcdf, write_netcdf
+from ddmm.utils.files import read_netcdf, write_netcdf
 
 __all__ = ["build_dataset", "save_dataset", "load_dataset", "binned_counts", "binned_rates", "psth",
            "describe_dataset", "cf_attrs", "TIME_ATTRS"]

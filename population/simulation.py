@@ -18,14 +18,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.models._executors import shared_executor
-from ddmm.models._resources import check_memory
-from ddmm.models._validation import check_choice, check_positive, shown
+from ddmm.utils.executors import shared_executor
+from ddmm.utils.resources import check_memory
+from ddmm.utils.validation import check_choice, check_positive, shown
 from ddmm.models.attenuation import F_TH, NO_SHEAR_READINGS
 from ddmm.models.current_filters import check_fs
 from ddmm.models.engines import METHODS, get_engine, prepare, substeps_for
 from ddmm.models.fused import FusedPipeline, mixing_matrix
-from ddmm.population._extras import require
+from ddmm.utils.extras import require
 from ddmm.population.anatomy.receptive_fields import frame_theta, local_mixing
 from ddmm.population.runtime.noise import noise_key, root_seed
 from ddmm.population.runtime.plan import _BYTES_PER_ELEMENT as _PLAN_BYTES_PER_ELEMENT
@@ -414,7 +414,7 @@ MIN_DT = 1e-6
 
 
 def _check_run_memory(population, scenes, the_plan, trials) -> None:
-    """Refuse, before any work, a run whose counts and working set cannot fit (`ddmm.models._resources`)."""
+    """Refuse, before any work, a run whose counts and working set cannot fit (`ddmm.utils.resources`)."""
     counts = 4.0 * len(scenes) * trials * len(population)  # spike_count, int32
     working = the_plan.chunk_size * the_plan.time_chunk * _PLAN_BYTES_PER_ELEMENT * max(1, os.cpu_count() or 1)
     check_memory(counts + working, f"a run of {len(scenes)} condition(s) x {trials:,} trial(s) x {len(population):,} "

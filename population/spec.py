@@ -49,7 +49,7 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from ddmm.models._validation import shown
+from ddmm.utils.validation import shown
 from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import UNTUNED
 from ddmm.models.current_params import CurrentParams

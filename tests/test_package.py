@@ -76,7 +76,7 @@ def test_version(capsys):
 
 
 def _source_packages() -> set:
-    found = {"ddmm"}
+    found = {"ddmm"} | {f"ddmm.{init.parent.name}" for init in (ROOT / "ddmm").glob("*/__init__.py")}
     for top in SOURCE_DIRS:
         for init in (ROOT / top).rglob("__init__.py"):
             found.add("ddmm." + ".".join(init.parent.relative_to(ROOT).parts))
@@ -100,19 +100,87 @@ def test_exported_names_never_equal_submodule_names(package):
         getattr(pkg, name)  # every exported name resolves
 
 
-def test_no_caller_compares_engine_names():
-    """Engines are registered objects (`ddmm.models.engines.registry`): the library never compares a name to pick one.
+ENGINE_NAMES = ("direct", "brian2")
 
-    (Benchmarks and figures in ``experiments/`` may label results by engine name.)
+
+def _engine_name_offences(path: Path) -> list:
+    """Comparisons with an engine name, and literals that list two or more engine names, in one file."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        sides = ()
+        if isinstance(node, ast.Compare):
+            sides = (node.left, *node.comparators)
+        elif isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+            sides = node.elts if sum(isinstance(e, ast.Constant) and e.value in ENGINE_NAMES
+                                     for e in node.elts) >= 2 else ()
+        elif isinstance(node, ast.Dict):
+            sides = node.keys if sum(isinstance(k, ast.Constant) and k.value in ENGINE_NAMES
+                                     for k in node.keys) >= 2 else ()
+        if any(isinstance(s, ast.Constant) and s.value in ENGINE_NAMES for s in sides):
+            found.append(f"{path.relative_to(ROOT)}:{node.lineno}")
+    return found
+
+
+def test_no_caller_compares_or_lists_engine_names():
+    """Engines are registered objects (`ddmm.models.engines.registry`): no code outside the registry compares
+    an engine's name to pick one, or lists the engines by name (``--engine`` choices come from the registry).
+
+    Naming one engine to use (``engine="direct"``) is allowed; the registry itself is exempt.
     """
-    offenders = []
-    for path in [*(ROOT / "models").rglob("*.py"), *(ROOT / "population").rglob("*.py")]:
-        for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, ast.Compare):
-                for side in (node.left, *node.comparators):
-                    if isinstance(side, ast.Constant) and side.value in ("direct", "brian2"):
-                        offenders.append(f"{path.relative_to(ROOT)}:{node.lineno}")
+    registry = ROOT / "models" / "engines" / "registry.py"
+    offenders = [hit for top in SOURCE_DIRS for path in (ROOT / top).rglob("*.py") if path != registry
+                 for hit in _engine_name_offences(path)]
     assert not offenders, offenders
+
+
+def test_the_engine_name_check_catches_a_listing(tmp_path, monkeypatch):
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    (tmp_path / "cli.py").write_text('CHOICES = ("brian2", "direct")\nif engine == "direct":\n    pass\n'
+                                     'OK = {"direct": 1}\n')
+    assert _engine_name_offences(tmp_path / "cli.py") == ["cli.py:1", "cli.py:2"]
+
+
+def _private_imports(path: Path, top: str) -> list:
+    """Imports in ``path`` (in top package ``top``) of an underscore name or a private module of another top package."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            modules, names = [node.module], [a.name for a in node.names]
+        elif isinstance(node, ast.Import):
+            modules, names = [a.name for a in node.names], []
+        else:
+            continue
+        for module in modules:
+            parts = module.split(".")
+            if parts[0] != "ddmm" or len(parts) < 2 or parts[1] == top:
+                continue
+            private = [p for p in parts[1:] if p.startswith("_")] + \
+                      [n for n in names if n.startswith("_") and not n.startswith("__")]
+            if private:
+                found.append(f"{path.relative_to(ROOT)}:{node.lineno}: {module} {private}")
+    return found
+
+
+def test_no_private_import_across_top_packages():
+    """`ddmm.models`, `ddmm.population`, `ddmm.experiments` and `ddmm.utils` use each other's public names only."""
+    tops = {"models": ROOT / "models", "population": ROOT / "population", "experiments": ROOT / "experiments",
+            "utils": ROOT / "ddmm" / "utils"}
+    offenders = [hit for top, folder in tops.items() for path in folder.rglob("*.py")
+                 for hit in _private_imports(path, top)]
+    assert not offenders, offenders
+
+
+def test_the_private_import_check_catches_one(tmp_path, monkeypatch):
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    (tmp_path / "m.py").write_text("from ddmm.models._x import a\nfrom ddmm.models.y import _b\n"
+                                   "from ddmm.population.z import c\nfrom ddmm import __version__\n")
+    assert len(_private_imports(tmp_path / "m.py", "population")) == 2
+
+
+def test_experiments_top_level_stays_small():
+    """`ddmm.experiments` is laid out by purpose (cli, paper, calibration, validation, bench, plots)."""
+    modules = sorted(p.name for p in (ROOT / "experiments").glob("*.py"))
+    assert len(modules) <= 8, modules
 
 
 def test_no_tracked_file_points_outside_the_repository():

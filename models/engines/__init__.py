@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models._validation import as_finite_array, check_choice, check_positive
+from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 from ddmm.models.engines.registry import Engine, engine_names, get_engine, register_engine
 from ddmm.models.neuron import V_FLOOR, V_PEAK, NeuronParams, neuron_arrays, resting_state
 

@@ -30,7 +30,7 @@ import os
 import numba as nb
 import numpy as np
 
-from ddmm.models._executors import shared_executor
+from ddmm.utils.executors import shared_executor
 from ddmm.models.neuron import refractory_steps
 
 __all__ = ["run_direct", "default_threads", "BLOCK", "METHOD_CODES", "integrate_range", "integrate_parts", "part_bounds",

@@ -35,9 +35,12 @@ class Engine:
     fused : bool
         Whether the pipeline's currents and the neurons run in one pass
         (`ddmm.models.fused.FusedPipeline.spikes`) instead of through `run`.
+    summary : str
+        One line on what the engine is, for help texts (``ddmm --engine``).
     """
 
     name: str = ""
+    summary: str = ""
     block_size: int = 4096
     task_block_size: int = 4096
     part_size: int | None = None
@@ -71,6 +74,7 @@ class DirectEngine(Engine):
     """The numba integrator: small blocks that stay in cache, fused with the pipeline, threaded pushes."""
 
     name = "direct"
+    summary = "the numba integrator: the same spikes bit for bit, no C++ compile, usually faster"
     #: A block's filter and neuron state stay in L2 and both threads stay busy to
     #: the end (the hand x 1 s: 0.18 s with 4096, 0.155-0.165 s with 512).
     block_size = 512
@@ -99,12 +103,13 @@ class Brian2Engine(Engine):
     """Brian2's C++ standalone device: large blocks, each a run of a compiled binary."""
 
     name = "brian2"
+    summary = "Brian2's C++ standalone device, compiled once per shape"
 
     def prepare(self) -> None:
         # ``import brian2`` installs a SIGINT handler, which Python allows only in the main thread.
-        from .brian2.engine import _import_brian2
+        from .brian2.engine import import_brian2
 
-        _import_brian2()
+        import_brian2()
 
     def run(self, current, substeps, dt, params, v, u, r, *, method, v_peak, v_floor):
         from .brian2.engine import run_brian2

@@ -9,7 +9,7 @@
 - `physiology`: the physiology scorecard against human recordings.
 """
 
-from ddmm.models._lazy import lazy_exports
+from ddmm.utils.lazy import lazy_exports
 
 _WHERE = {
     "tuning": ("direction_tuning", "tuning_scenes", "tuning_summary"),

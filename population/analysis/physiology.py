@@ -5,7 +5,7 @@ per property: its afferent type, protocol, statistic, the model's value, the
 reference range and its source, the role (``fitted`` when ``ddmm calibrate``
 uses it, ``constrained`` when it bounds the fit, ``held out`` when no
 objective ever saw it) and pass/fail.  The reference ranges are data, passed
-in (`Reference`); the package's own live in ``experiments/paper_values.py``.
+in (`Reference`); the package's own live in ``population/data/published.py``.
 
 The rows come from protocol modules: the core battery (`physiology_core`:
 rest, on/off, rates, force and frequency coding, direction, timing,
@@ -151,7 +151,7 @@ def score_physiology(population, references: dict, *, properties=None, seed: int
     population : Population
         The afferents (e.g. ``sample_population("fingertip", rng=0)``).
     references : dict
-        `Reference` per property name (``ddmm.experiments.paper_values.PHYSIOLOGY_REFERENCE``).
+        `Reference` per property name (``ddmm.population.data.published.PHYSIOLOGY_REFERENCE``).
     properties : sequence of str, optional
         Names from `PROPERTIES` (default: all).
     seed : int

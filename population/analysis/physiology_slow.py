@@ -1,7 +1,7 @@
 """Scorecard protocols of the slowly adapting types: SA-II under normal force and at rest, SA-I dynamics.
 
 Registered through `ddmm.population.analysis.physiology.load_extensions`; the
-reference ranges are ``ddmm.experiments.paper_values._slow_reference``.
+reference ranges are ``ddmm.population.data.published._slow_reference``.
 Forces in N, +Z into the skin; only the SA-I and SA-II afferents of the
 population are simulated.
 

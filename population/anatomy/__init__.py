@@ -4,7 +4,7 @@
 - `receptive_fields`: how strongly each force site drives each afferent.
 """
 
-from ddmm.models._lazy import lazy_exports
+from ddmm.utils.lazy import lazy_exports
 
 _WHERE = {
     "hand_map": ("HandRegion", "REGIONS", "get_region", "outline", "region_at", "region_counts", "region_names",

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models._validation import shown
+from ddmm.utils.validation import shown
 
 __all__ = ["Ellipse", "Polygon", "HandRegion", "KINDS", "TYPES", "DENSITY_PER_CM2", "TYPE_SHARE",
            "REGIONS", "region_names", "get_region", "region_at", "sample_in_region", "region_counts",

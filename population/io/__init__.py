@@ -7,10 +7,11 @@
 A Dataset's own netCDF round trip is `ddmm.population.dataset`.
 """
 
-from ddmm.models._lazy import lazy_exports
+from ddmm.utils.lazy import lazy_exports
 
 _WHERE = {
     "arrays": ("from_array", "from_long_csv", "save_array"),
+    "_long_csv": ("read_sites_csv",),
     "nwb": ("to_nwb",),
     "neo_export": ("to_neo",),
     "brian2_export": ("to_brian2",),

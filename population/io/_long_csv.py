@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models._validation import parse_number
+from ddmm.utils.validation import parse_number
 
 __all__ = ["TIME_TOL", "read_sites_csv", "read_long_forces", "uniform_grid"]
 

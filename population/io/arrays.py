@@ -68,7 +68,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.population.io._files import atomic_write
+from ddmm.utils.files import atomic_write
 from ddmm.population.io._long_csv import TIME_TOL, read_long_forces, read_sites_csv, uniform_grid
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.recordings import RECORDED, warn_band
@@ -472,7 +472,7 @@ def from_long_csv(forces_csv, sites_csv, *, fs: float | None = None, name: str |
     (2, 2, 100.0, ['a', 'b'])
     """
     if fs is not None:
-        from ddmm.models._validation import check_positive
+        from ddmm.utils.validation import check_positive
 
         fs = check_positive(fs, "fs", "Hz")
     sites_where, table, site_lines = read_sites_csv(sites_csv)

@@ -30,7 +30,7 @@ import numbers
 
 import numpy as np
 
-from ddmm.models._validation import check_positive
+from ddmm.utils.validation import check_positive
 from ddmm.population.io import _export as ex
 
 __all__ = ["to_brian2"]
@@ -112,7 +112,7 @@ def to_brian2(dataset, condition=0, trial=0, *, dt=None, join_trials=False, merg
 
 def _import_brian2():
     """Brian2, imported the engine's way (it does not take over the process's warnings and logging)."""
-    from ddmm.models.engines.brian2.engine import _import_brian2 as import_brian2
+    from ddmm.models.engines.brian2 import import_brian2
 
     return import_brian2()
 

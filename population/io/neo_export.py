@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.population._extras import require
+from ddmm.utils.extras import require
 from ddmm.population.io import _export as ex
 
 __all__ = ["to_neo"]

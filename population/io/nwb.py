@@ -31,7 +31,7 @@ Layout (core NWB types only, no extension):
   on the session clock; multi-site scenes add ``stimulus["site_force"]``
   (n, n_sites, 3), whose description lists the sites in order.
 * **Stimulation pulses**, when ``pulses`` is given (a pulses Dataset of
-  `ddmm.population.stimulation.stimulation_pulses` for the same run):
+  `ddmm.population.neurostim.stimulation_pulses` for the same run):
   ``nwbfile.intervals["stimulation_pulses"]``, a TimeIntervals table with one
   row per pulse in the Dataset's order, ``start_time`` = the start of the
   cathodic phase on the session clock (``trials.start_time[k] + pulse_time``,
@@ -66,9 +66,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.population._extras import require
+from ddmm.utils.extras import require
 from ddmm.population.io import _export as ex
-from ddmm.population.io._files import atomic_write, writable_parent
+from ddmm.utils.files import atomic_write, writable_parent
 
 __all__ = ["to_nwb", "PAPER_DOI", "REFERENCE_START"]
 
@@ -112,7 +112,7 @@ def to_nwb(dataset, path, *, session_description: str | None = None, identifier:
         DOIs or URLs (``"doi:..."``); default the DDMM paper's data DOI
         (`PAPER_DOI`); ``()`` for none.
     pulses : xarray.Dataset, optional
-        Stimulation pulses of this run (`ddmm.population.stimulation.stimulation_pulses`
+        Stimulation pulses of this run (`ddmm.population.neurostim.stimulation_pulses`
         or `load_pulses`), written as ``intervals["stimulation_pulses"]`` with the
         electrode table (module docstring).  Its conditions, trial count and
         sample rate must be the dataset's.
@@ -140,7 +140,7 @@ def to_nwb(dataset, path, *, session_description: str | None = None, identifier:
 
     With the stimulation pulses of the same run:
 
-    >>> from ddmm.population.stimulation import Electrode, stimulation_pulses
+    >>> from ddmm.population.neurostim import Electrode, stimulation_pulses
     >>> table = [Electrode("E1", 20.0, 80.0, 200.0, 300.0, 20.0, x_mm=0.0, y_mm=0.0, radius_mm=10.0)]
     >>> pulses = stimulation_pulses(ds, table)
     >>> with tempfile.TemporaryDirectory() as tmp:
@@ -368,7 +368,7 @@ def _check_pulses(ds, pulses) -> None:
     if pulses is None:
         return
     if not isinstance(pulses, xr.Dataset) or pulses.attrs.get("layout") != "ddmm stimulation pulses":
-        raise TypeError(f"to_nwb: pulses must be a pulses Dataset (ddmm.population.stimulation.stimulation_pulses "
+        raise TypeError(f"to_nwb: pulses must be a pulses Dataset (ddmm.population.neurostim.stimulation_pulses "
                         f"or load_pulses) or None, got {type(pulses).__name__}")
     ours, theirs = [str(v) for v in ds["condition"].values], [str(v) for v in pulses["condition"].values]
     if theirs != ours:
@@ -390,7 +390,7 @@ def _add_stimulation(nwbfile, ds, pulses, starts) -> None:
     """``intervals["stimulation_pulses"]`` and ``processing["stimulation"]["stimulation_electrodes"]``."""
     module = nwbfile.create_processing_module(
         name="stimulation", description="Stimulation computed from the simulated afferents for a nerve interface "
-                                        "(ddmm.population.stimulation): the electrode table; the pulses are "
+                                        "(ddmm.population.neurostim): the electrode table; the pulses are "
                                         "intervals['stimulation_pulses']")
     module.add(_electrode_table(pulses))
     if pulses.sizes["pulse"]:

@@ -10,7 +10,7 @@
   ``ddmm[lsl]``).
 """
 
-from ddmm.models._lazy import lazy_exports
+from ddmm.utils.lazy import lazy_exports
 
 _WHERE = {
     "plan": ("RECORD_CHOICES", "ConditionPlan", "Plan", "make_plan"),

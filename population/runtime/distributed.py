@@ -76,7 +76,7 @@ def run_distributed(client, jobs, config, run_chunk, progress=None) -> list:
     """Submit one task per job; return the results in job order."""
     from distributed import as_completed
 
-    from ddmm.models._cache import cache_root
+    from ddmm.utils.cache import cache_root
 
     client.register_plugin(DdmmWorkerPlugin(config.engine, str(cache_root())), name="ddmm")
     futures = [client.submit(run_chunk, job, config, pure=False) for job in jobs]

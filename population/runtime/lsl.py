@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models._validation import check_positive, shown
-from ddmm.population._extras import require
+from ddmm.utils.validation import check_positive, shown
+from ddmm.utils.extras import require
 from ddmm.population.stimuli.recordings import UNITS
 
 __all__ = ["SPIKE_STREAM_TYPE", "FORCE_STREAM_TYPE", "PULSE_STREAM_TYPE", "ForceStream", "ChunkReader",

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ddmm.models._validation import check_positive
+from ddmm.utils.validation import check_positive
 from ddmm.population.runtime.lsl import ChunkReader, ForceStream, _pylsl
 
 __all__ = ["GAP_FACTOR", "BridgeSummary", "Bridge", "check_stamps", "play_forces"]

@@ -126,7 +126,7 @@ class PulseOutlet:
             channel = channels.append_child("channel")
             channel.append_child_value("label", label)
             channel.append_child_value("unit", unit)
-        from ddmm.population.stimulation.encode import WAVEFORM
+        from ddmm.population.neurostim.encode import WAVEFORM
 
         desc.append_child_value("waveform", WAVEFORM)
         desc.append_child_value("rule", repr(stimulator.rule))

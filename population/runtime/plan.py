@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models._validation import check_choice
+from ddmm.utils.validation import check_choice
 from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import F_TH, UNTUNED
 from ddmm.models.variability import bias_multiplier

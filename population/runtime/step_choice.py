@@ -17,7 +17,7 @@ import json
 from functools import lru_cache
 from importlib import resources
 
-from ddmm.models._validation import check_positive
+from ddmm.utils.validation import check_positive
 
 __all__ = ["load_table", "choose_setting"]
 

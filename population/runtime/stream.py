@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models._validation import as_finite_array, check_choice, check_positive
+from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 from ddmm.models.attenuation import NO_SHEAR_READINGS
 from ddmm.models.current_filters import check_fs
 from ddmm.models.engines import METHODS, get_engine, substeps_for

@@ -9,7 +9,7 @@
 - `site_scenes`: scenes only force fields can express (torsion, slip, grasp).
 """
 
-from ddmm.models._lazy import lazy_exports
+from ddmm.utils.lazy import lazy_exports
 
 _WHERE = {
     "scenes": ("DEFAULT_FS", "Contact", "Scene", "Sites", "Stage", "birznieks", "press_push_lift",

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.models._resources import check_memory
-from ddmm.models._validation import check_positive, parse_number, shown
+from ddmm.utils.resources import check_memory
+from ddmm.utils.validation import check_positive, parse_number, shown
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.scenes import DEFAULT_FS, MAX_FS, Contact, Scene
 

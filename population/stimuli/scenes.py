@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ddmm.models._resources import check_memory
-from ddmm.models._validation import as_finite_array, check_positive, shown
+from ddmm.utils.resources import check_memory
+from ddmm.utils.validation import as_finite_array, check_positive, shown
 
 __all__ = [
     "DEFAULT_FS",
@@ -328,7 +328,7 @@ def birznieks(direction_deg: float | None = 90.0, *, normal_n: float = 4.0, angl
         The tangential force starts this long after the normal force and
         reaches its plateau with it (s, in [0, ``ramp_s``); default 0: both
         together, as drawn in paper Fig. 6a).  A parameter of the paper
-        calibration (`ddmm.experiments.paper_calibration`).
+        calibration (`ddmm.experiments.paper.calibrations`).
 
     Examples
     --------
@@ -373,7 +373,7 @@ def press_push_lift(theta_r: float = 90.0, *, press_n: float = 3.0, push_n: floa
 
     Each stage is a dynamic period (D, the ramp) then a static one (S).  The
     paper gives neither ramp length nor the shear's onset: they are
-    parameters of the paper calibration (`ddmm.experiments.paper_calibration`).
+    parameters of the paper calibration (`ddmm.experiments.paper.calibrations`).
 
     Examples
     --------

@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models._validation import check_positive, shown
+from ddmm.utils.validation import check_positive, shown
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Scene, Sites, Stage, taxel_radius
 
 __all__ = ["contact_grid", "torsion", "incipient_slip", "grasp", "digit_tip_sites"]

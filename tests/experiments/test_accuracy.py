@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
-from ddmm.experiments.accuracy import _compare, _run_times, measure, reference_times, workload
+from ddmm.experiments.validation.accuracy import _compare, _run_times, measure, reference_times, workload
 from ddmm.experiments.cli import main
 from ddmm.models.engines import SpikeCapWarning
 from ddmm.population import rotating_shear, simulate

@@ -77,7 +77,7 @@ def test_every_help_page_prints(capsys):
 
 
 def test_plot_scaling_and_bench_case_names():
-    from ddmm.experiments.plotting import plot_scaling
+    from ddmm.experiments.plots.common import plot_scaling
 
     fig = plot_scaling([{"n_afferents": 1000, "sim_s": 1.0, "wall_s": 0.04},
                         {"n_afferents": 10000, "sim_s": 1.0, "wall_s": 0.3},

@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
-from ddmm.experiments.calibrate import spec_to_toml
+from ddmm.experiments.calibration.presets import spec_to_toml
 from ddmm.experiments.cli import main
-from ddmm.experiments.decoding import run_decoding, summarise
+from ddmm.experiments.validation.decoding import run_decoding, summarise
 from ddmm.population import load_spec, spec_from_dict
 
 
@@ -72,7 +72,7 @@ def test_calibrated_spec_round_trips_through_toml(name):
 
 @pytest.mark.slow
 def test_calibration_reproduces_the_committed_preset():
-    from ddmm.experiments.calibrate import calibrate
+    from ddmm.experiments.calibration.presets import calibrate
 
     spec, report = calibrate()
     committed = load_spec("fingertip")

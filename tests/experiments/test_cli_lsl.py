@@ -148,7 +148,7 @@ def test_a_stream_of_the_wrong_width_and_a_missing_extra(capsys, monkeypatch):
 
 
 def test_the_bench_latency_is_per_sample_until_its_last_spike():
-    from ddmm.experiments.bench_lsl import _latencies
+    from ddmm.experiments.bench.lsl import _latencies
 
     pushed = 10.0 + np.arange(5) / 1000.0 + 0.0002  # pushed 0.2 ms after each due time
     anchor = 10.0  # due time of sample 0 on this host's clock
@@ -160,7 +160,7 @@ def test_stream_publishes_stimulation_pulses_equal_to_the_in_process_encoder(tmp
     """``ddmm stream --lsl-in F --electrodes E.csv --lsl-pulses P`` in another process: the pulses read here."""
     import pylsl
 
-    from ddmm.population.stimulation import StimulationEncoder, read_electrodes
+    from ddmm.population.neurostim import StimulationEncoder, read_electrodes
 
     table = tmp_path / "e.csv"
     table.write_text("id,x_mm,y_mm,radius_mm,region,amplitude_min_ua,amplitude_max_ua,phase_width_us,max_rate_hz,"

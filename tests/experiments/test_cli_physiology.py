@@ -50,7 +50,7 @@ def test_phase_locking_rows_and_cycle_histograms(capsys, tmp_path):
 def test_cycle_histograms_plot_one_panel_per_type():
     import numpy as np
 
-    from ddmm.experiments.plot_physiology import plot_cycle_histograms
+    from ddmm.experiments.plots.physiology import plot_cycle_histograms
 
     phases = np.r_[np.full(30, 0.25), np.full(10, 0.75)]
     fig = plot_cycle_histograms({"RAI": {"frequency_hz": 20.0, "phases": phases},

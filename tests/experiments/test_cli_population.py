@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from ddmm.experiments.bench_cases import CASES, run_case
+from ddmm.experiments.bench.cases import CASES, run_case
 from ddmm.experiments.cli import main
 from ddmm.population import load_dataset
 

@@ -43,7 +43,7 @@ def test_columns_and_units_from_the_command_line(tmp_path, capsys):
 
 def test_the_shear_hold_option_reaches_the_conditioning():
     from ddmm.experiments.cli import build_parser
-    from ddmm.experiments.cmd_recordings import conditioning_from_args
+    from ddmm.experiments.cli.recording_options import conditioning_from_args
 
     parse = build_parser().parse_args
     assert conditioning_from_args(parse(["simulate", "--out", "x.nc", "--shear-hold", "0"])).shear_hold_n == 0.0

@@ -5,7 +5,7 @@ import pytest
 
 from ddmm.experiments.cli import main
 from ddmm.population import Contact, Scene, make_population, save_dataset, simulate
-from ddmm.population.stimulation import check_pulses, load_pulses
+from ddmm.population.neurostim import check_pulses, load_pulses
 
 HEADER = "id,x_mm,y_mm,radius_mm,region,amplitude_min_ua,amplitude_max_ua,phase_width_us,max_rate_hz,charge_limit_nc\n"
 

@@ -70,7 +70,7 @@ def test_simulate_reports_wall_time_and_the_engine_help_names_direct(capsys, tmp
 
 
 def test_forces_legend_never_covers_a_trace():
-    from ddmm.experiments.plotting import plot_forces
+    from ddmm.experiments.plots.common import plot_forces
     from ddmm.population import press_push_lift, sample_population, simulate
 
     pop = sample_population("fingertip", rng=0).select(range(3))

@@ -5,10 +5,10 @@ import json
 import numpy as np
 import pytest
 
-from ddmm.experiments.calibrate_paper import FIT_CELLS, objective, type_config
+from ddmm.experiments.calibration.paper import FIT_CELLS, objective, type_config
 from ddmm.experiments.cli import main
-from ddmm.experiments.paper_calibration import CALIBRATIONS, FITTED_CELLS, PAPER_CALIBRATION, PAPER_OBJECTIVES
-from ddmm.experiments.paper_cells import cell_keys, reproduce_cells
+from ddmm.experiments.paper.calibrations import CALIBRATIONS, FITTED_CELLS, PAPER_CALIBRATION, PAPER_OBJECTIVES
+from ddmm.experiments.paper.cells import cell_keys, reproduce_cells
 from ddmm.population import press_push_lift
 
 CELL_FIELDS = {"table", "type", "profile", "row", "paper", "model", "rel_error", "role"}
@@ -128,7 +128,7 @@ def test_table4_errors_are_one_line(capsys, argv, match):
 @pytest.mark.slow
 def test_the_fit_reproduces_the_committed_ra_i_setting():
     """``ddmm calibrate --target paper`` for RA-I (its chosen reading and SF definition) gives the committed values."""
-    from ddmm.experiments.calibrate_paper import fit_type
+    from ddmm.experiments.calibration.paper import fit_type
 
     committed = PAPER_CALIBRATION["RAI"]
     fit = fit_type("RAI", committed.no_shear, committed.sf_definition, seed=0)

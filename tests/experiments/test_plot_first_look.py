@@ -3,7 +3,7 @@
 import numpy as np
 from matplotlib.figure import Figure
 
-from ddmm.experiments.plot_first_look import plot_ramp_and_hold, ramp_and_hold, ramp_and_hold_scene
+from ddmm.experiments.plots.first_look import plot_ramp_and_hold, ramp_and_hold, ramp_and_hold_scene
 from ddmm.population import sample_population
 
 

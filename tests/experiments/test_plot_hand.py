@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-from ddmm.experiments.plot_hand import hand_counts, plot_hand
+from ddmm.experiments.plots.hand import hand_counts, plot_hand
 from ddmm.models.currents import type_label
 from ddmm.population import birznieks, make_population, sample_population, simulate
 from ddmm.population.anatomy import hand_map

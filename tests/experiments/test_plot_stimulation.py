@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-from ddmm.experiments.plot_stimulation import plot_stimulation
+from ddmm.experiments.plots.neurostim import plot_stimulation
 from ddmm.population import birznieks, sample_population, simulate
-from ddmm.population.stimulation import Electrode, stimulation_pulses
+from ddmm.population.neurostim import Electrode, stimulation_pulses
 
 TABLE = [Electrode("E1", 20.0, 80.0, 200.0, 300.0, 20.0, x_mm=0.0, y_mm=0.0, radius_mm=4.0),
          Electrode("E2", 10.0, 60.0, 100.0, 200.0, 10.0, x_mm=5.0, y_mm=-5.0, radius_mm=3.0),

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ddmm.experiments.reproduce import FIG8_ANGLES, PROFILES, ReproConfig, reproduce_all, scene_sf
+from ddmm.experiments.paper.reproduce import FIG8_ANGLES, PROFILES, ReproConfig, reproduce_all, scene_sf
 from ddmm.population.stimuli.scenes import birznieks, press_push_lift
 
 TYPES = ("SAI", "RAI", "RAII")

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ddmm.models import integrate
-from ddmm.models._cache import private_dir
+from ddmm.utils.cache import private_dir
 from ddmm.models.engines.brian2 import engine
 
 _RUN = """

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from ddmm.experiments.paper_values import PAPER_RADII_K3
+from ddmm.population.data.published import PAPER_RADII_K3
 from ddmm.models.nap import PROFILES, boundary_radius, get_profile, k_from_selectivity, selectivity_from_k, tip_radius
 
 

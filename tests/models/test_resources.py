@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ddmm.models._resources import MEMORY_ENV, available_bytes, check_memory
+from ddmm.utils.resources import MEMORY_ENV, available_bytes, check_memory
 from ddmm.population import birznieks, load_spec, rotating_shear, sample_population, simulate
 from ddmm.population.spec import TypeSpec
 
@@ -49,7 +49,7 @@ def test_absurd_counts_and_steps_are_refused():
 
 
 def _sum_on_the_shared_pool():
-    from ddmm.models._executors import shared_executor
+    from ddmm.utils.executors import shared_executor
 
     return shared_executor("test-fork", 1).submit(sum, [1, 2]).result(timeout=10)
 
@@ -59,7 +59,7 @@ def test_a_forked_child_gets_a_pool_of_its_own():
     # wait forever (here: the 10 s timeout).
     import multiprocessing
 
-    from ddmm.models._executors import shared_executor
+    from ddmm.utils.executors import shared_executor
 
     assert shared_executor("test-fork", 1).submit(sum, [2, 2]).result() == 4  # the parent's pool exists
     with multiprocessing.get_context("fork").Pool(1) as pool:

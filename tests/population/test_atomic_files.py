@@ -5,12 +5,12 @@ import signal
 import subprocess
 import sys
 
-from ddmm.population.io._files import _tag, atomic_write, sweep_stale_parts
+from ddmm.utils.files import _tag, atomic_write, sweep_stale_parts
 
 _WRITER = """
 import sys, time
 from pathlib import Path
-from ddmm.population.io._files import atomic_write
+from ddmm.utils.files import atomic_write
 
 def write(tmp):
     Path(tmp).write_text("half")

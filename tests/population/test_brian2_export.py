@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ddmm.models.engines.brian2.engine import _import_brian2
+from ddmm.models.engines.brian2 import import_brian2 as _import_brian2
 from ddmm.population import birznieks, make_population, simulate
 from ddmm.population.io import to_brian2
 

@@ -7,7 +7,7 @@ import pytest
 
 from ddmm.population import (Scene, Sites, birznieks, load_dataset, make_population, sample_population, save_dataset,
                              simulate)
-from ddmm.population.stimulation import Electrode, load_pulses, save_pulses, stimulation_pulses
+from ddmm.population.neurostim import Electrode, load_pulses, save_pulses, stimulation_pulses
 
 GLOBAL = ("Conventions", "title", "institution", "source", "history", "references", "comment")
 

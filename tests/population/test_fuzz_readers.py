@@ -120,7 +120,7 @@ _ELECTRODE_FIELDS = ["id", "x_mm", "y_mm", "radius_mm", "region", "amplitude_min
 @given(header=st.lists(st.sampled_from(_ELECTRODE_FIELDS), min_size=0, max_size=11),
        rows=st.lists(st.lists(_CELL, min_size=0, max_size=11), max_size=5))
 def test_electrode_table_csv_reader(tmp_path_factory, header, rows):
-    from ddmm.population.stimulation import ElectrodeTable, read_electrodes
+    from ddmm.population.neurostim import ElectrodeTable, read_electrodes
 
     path = tmp_path_factory.mktemp("electrodes") / "e.csv"
     path.write_text(_csv_text([header] + rows))
@@ -138,7 +138,7 @@ def test_electrode_table_csv_reader(tmp_path_factory, header, rows):
 @_FUZZ
 @given(text=st.text(max_size=300), nested=st.integers(0, 3000))
 def test_electrode_table_toml_reader(tmp_path_factory, text, nested):
-    from ddmm.population.stimulation import read_electrodes
+    from ddmm.population.neurostim import read_electrodes
 
     path = tmp_path_factory.mktemp("electrodes") / "e.toml"
     path.write_text(("x = " + "[" * nested + "]" * nested + "\n") if nested > 2 else text)

@@ -277,7 +277,7 @@ def test_open_force_stream_errors_name_the_problem():
 def test_a_missing_extra_is_one_line_naming_the_install(monkeypatch):
     import sys
 
-    from ddmm.population._extras import MissingExtraError
+    from ddmm.utils.extras import MissingExtraError
 
     monkeypatch.setitem(sys.modules, "pylsl", None)
     with pytest.raises(MissingExtraError, match=r'pip install "ddmm\[lsl\]"'):
@@ -289,7 +289,7 @@ def test_stimulation_pulses_over_lsl_equal_the_offline_stimulation_encoder(recor
     import pylsl
 
     from ddmm.population.runtime.lsl_outlets import PulseOutlet
-    from ddmm.population.stimulation import Electrode, StimulationEncoder
+    from ddmm.population.neurostim import Electrode, StimulationEncoder
 
     pop, raw, _, _ = recording
     table = [Electrode("centre", 20.0, 80.0, 200.0, 300.0, 20.0, x_mm=0.0, y_mm=0.0, radius_mm=5.0),

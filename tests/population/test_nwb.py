@@ -237,7 +237,7 @@ ELECTRODES = "\n".join([
 @pytest.fixture(scope="module")
 def stimulated(nc, tmp_path_factory):
     """The `nc` run, its pulses on three electrodes (one far from every afferent: no pulses) and their NWB file."""
-    from ddmm.population.stimulation import stimulation_pulses
+    from ddmm.population.neurostim import stimulation_pulses
 
     tmp = tmp_path_factory.mktemp("stim")
     (tmp / "electrodes.csv").write_text(ELECTRODES)
@@ -316,7 +316,7 @@ def test_pulses_of_another_run_are_refused(stimulated, tmp_path, edit, match):
 
 
 def test_cli_export_with_pulses(stimulated, nc, tmp_path, capsys):
-    from ddmm.population.stimulation import save_pulses
+    from ddmm.population.neurostim import save_pulses
 
     ds, pulses, _ = stimulated
     pulses_nc = save_pulses(pulses, tmp_path / "pulses.nc")

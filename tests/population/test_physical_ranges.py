@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ddmm.models._validation import parse_number
+from ddmm.utils.validation import parse_number
 from ddmm.population import Contact, Scene, Sites, birznieks, load_dataset, load_spec, save_array
 from ddmm.population.stimuli.recordings import from_csv
 from ddmm.population.stimuli.scenes import Stage

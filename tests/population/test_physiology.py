@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ddmm.experiments.paper_values import PHYSIOLOGY_REFERENCE
+from ddmm.population.data.published import PHYSIOLOGY_REFERENCE
 from ddmm.population import Scene, make_population, sample_population, simulate
 from ddmm.population.analysis.physiology import PROPERTIES, Reference, score_physiology, summarise_scorecard
 

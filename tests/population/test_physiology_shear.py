@@ -4,7 +4,7 @@ from dataclasses import replace
 
 import pytest
 
-from ddmm.experiments.paper_values import PHYSIOLOGY_REFERENCE
+from ddmm.population.data.published import PHYSIOLOGY_REFERENCE
 from ddmm.population import sample_population
 from ddmm.population.analysis import physiology, physiology_shear
 

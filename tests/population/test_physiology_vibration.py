@@ -5,7 +5,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from ddmm.experiments.paper_values import PHYSIOLOGY_REFERENCE
+from ddmm.population.data.published import PHYSIOLOGY_REFERENCE
 from ddmm.population import sample_population
 from ddmm.population.analysis import physiology_vibration as vib
 from ddmm.population.analysis.physiology import PROPERTIES, score_physiology

@@ -2,7 +2,7 @@
 
 import pytest
 
-from ddmm.experiments.paper_values import TOUCHSIM_COUNTS
+from ddmm.population.data.published import TOUCHSIM_COUNTS
 from ddmm.population.anatomy import hand_map
 from ddmm.population.spec import load_spec, spec_from_dict
 

@@ -8,9 +8,9 @@ from hypothesis import strategies as st
 from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.population import Contact, Scene, Sites, sample_population, simulate
 from ddmm.population.runtime import Encoder
-from ddmm.population.stimulation import (Biomimetic, Electrode, ElectrodeTable, PulseKernel, StimulationEncoder,
+from ddmm.population.neurostim import (Biomimetic, Electrode, ElectrodeTable, PulseKernel, StimulationEncoder,
                                          check_pulses, load_pulses, read_electrodes, save_pulses, stimulation_pulses)
-from ddmm.population.stimulation.pulses import disc_overlap
+from ddmm.population.neurostim.pulses import disc_overlap
 
 RULES = ("biomimetic", "linear-amplitude", "linear-frequency")
 
@@ -132,7 +132,7 @@ def test_every_limit_holds_for_random_tables_spikes_and_forces(table, rule, seed
 def test_a_full_amplitude_command_never_rounds_over_the_electrode_maximum(code):
     """17.009 + (171.592 - 17.009) x 1 is 171.59200000000004 in floating point: the command must be 171.592.
     (Found by the random multi-site test: 161.667 uA reported outside [33.025, 161.667].)"""
-    from ddmm.population.stimulation.pulses import _commands
+    from ddmm.population.neurostim.pulses import _commands
 
     limits = np.array([[17.009, 171.592, 200.0, 100.0]])
     params = np.array([0.0, 1.0, 0.0, 0.5, 50.0, 1.0, 1.0])  # saturating rate, active fraction and force
@@ -142,7 +142,7 @@ def test_a_full_amplitude_command_never_rounds_over_the_electrode_maximum(code):
 
 def test_the_last_check_drops_a_pulse_closer_than_the_rate_limit_allows():
     """Even a command over the limit (which no rule gives) cannot place two pulses too close."""
-    from ddmm.population.stimulation.pulses import _pulses
+    from ddmm.population.neurostim.pulses import _pulses
 
     out_t, out_e, out_a = np.empty(100), np.empty(100, np.int64), np.empty(100)
     phase, last = np.zeros(1), np.full(1, -np.inf)

@@ -52,7 +52,7 @@ def test_summary_reports_absent_types(known):
 
 
 def test_fingertip_preset_meets_the_calibration_targets_over_five_seeds():
-    from ddmm.experiments.calibrate import validate
+    from ddmm.experiments.calibration.presets import validate
     from ddmm.population import load_spec
 
     stats = validate(load_spec("fingertip"), scorecard=False)["mean_sd"]

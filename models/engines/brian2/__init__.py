@@ -58,7 +58,7 @@ Importing this package does not import Brian2; `engine` does, when a
 project is first built.
 """
 
-__all__ = ["run_brian2", "cache_dir"]
+__all__ = ["run_brian2", "cache_dir", "import_brian2"]
 
 
 def __getattr__(name):

@@ -33,7 +33,7 @@ Design (measured on this machine kind, see docs/user-guide.md, "Engines"):
 * **A cache that can be trusted.**  The key includes the CPU the binary is
   compiled for (``-march=native``); the binary's SHA-256 is recorded when it
   is built and checked before every run (a mismatch is rebuilt, with one
-  line saying so); the cache directory must be private (`ddmm.models._cache.private_dir`).
+  line saying so); the cache directory must be private (`ddmm.utils.cache.private_dir`).
 * **Bounded tables.**  Runs are cut into time chunks of at most 2**25
   table elements (256 MB).
 """
@@ -58,11 +58,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.models._cache import cache_root, private_dir
+from ddmm.utils.cache import cache_root, private_dir
 from ddmm.models.engines.brian2.lanes import lane, write_table
 from ddmm.models.neuron import V_FLOOR, refractory_steps
 
-__all__ = ["run_brian2", "cache_dir", "Brian2Warning"]
+__all__ = ["run_brian2", "cache_dir", "import_brian2", "Brian2Warning"]
 
 _COMPILE_ARGS = ["-w", "-O3", "-ffp-contract=off", "-march=native", "-std=c++11"]
 _TEMPLATE_VERSION = "5"  # bump when the generated network changes
@@ -183,7 +183,7 @@ def _pad(n: int, quantum: int) -> int:
 
 
 def _key_dir(key: tuple) -> Path:
-    brian2 = _import_brian2()
+    brian2 = import_brian2()
 
     from ddmm.models.engines.brian2 import device
 
@@ -211,7 +211,7 @@ class _LogToWarnings(logging.Handler):
 _QUIETED = False
 
 
-def _import_brian2():
+def import_brian2():
     """Import Brian2 without letting it take over the process's warnings and logging.
 
     On import Brian2 calls ``logging.captureWarnings(True)``, which reroutes
@@ -239,7 +239,7 @@ def _import_brian2():
 @contextmanager
 def _brian2_prefs():
     """Set the preferences the build needs, restoring the user's afterwards."""
-    brian2 = _import_brian2()
+    brian2 = import_brian2()
 
     saved = {
         "codegen.cpp.extra_compile_args_gcc": list(brian2.prefs["codegen.cpp.extra_compile_args_gcc"]),

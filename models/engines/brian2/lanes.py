@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.models._cache import cache_root, private_dir
+from ddmm.utils.cache import cache_root, private_dir
 
 __all__ = ["lane", "write_table"]
 

@@ -1,0 +1,111 @@
+"""Argument checks shared by the public functions of every ddmm package (raise, never assert)."""
+
+from __future__ import annotations
+
+import numbers
+import re
+
+import numpy as np
+
+__all__ = ["as_finite_array", "check_positive", "check_choice", "check_forces", "parse_number", "shown"]
+
+
+def shown(value) -> str:
+    """A value as a message prints it: numbers plainly (``0.5``, not ``np.float64(0.5)``), anything else by repr.
+
+    Examples
+    --------
+    >>> shown(np.float64(0.5)), shown(np.int64(3)), shown("x"), shown(float("nan"))
+    ('0.5', '3', "'x'", 'nan')
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Number, np.number)):
+        return repr(value)
+    if isinstance(value, (numbers.Integral, np.integer)):
+        return str(int(value))
+    if isinstance(value, (numbers.Real, np.floating)):
+        return repr(float(value))
+    return repr(value)
+
+
+def as_finite_array(value, name: str, ndim: int | None = None) -> np.ndarray:
+    """Return ``value`` as a float64 array, raising if it holds NaN or inf.
+
+    Raises
+    ------
+    TypeError
+        If ``value`` is not numeric.
+    ValueError
+        If it has the wrong number of dimensions or a non-finite entry.
+    """
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be numeric, got {type(value).__name__}") from None
+    if ndim is not None and arr.ndim != ndim:
+        raise ValueError(f"{name} must be {ndim}-D, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        bad = int(np.flatnonzero(~np.isfinite(arr.ravel()))[0])
+        raise ValueError(
+            f"{name} must be finite; got {float(arr.ravel()[bad])} at flat index {bad}"
+        )
+    return arr
+
+
+def check_positive(value, name: str, unit: str = "") -> float:
+    """Return ``value`` as a float after checking it is finite and > 0."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
+    value = float(value)
+    if not np.isfinite(value) or value <= 0.0:
+        suffix = f" {unit}" if unit else ""
+        raise ValueError(f"{name} must be a finite number > 0{suffix}, got {shown(value)}")
+    return value
+
+
+def check_choice(value, name: str, allowed) -> str:
+    """Return ``value`` if it is one of ``allowed``; raise otherwise."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be a str, got {type(value).__name__}")
+    if value not in allowed:
+        raise ValueError(f"{name}={value!r} is not allowed; allowed: {', '.join(allowed)}")
+    return value
+
+
+def check_forces(fx, fy, fz) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Validate three force components in newtons (1-D, equal length, finite, F_Z >= 0)."""
+    fx = as_finite_array(fx, "fx", ndim=1)
+    fy = as_finite_array(fy, "fy", ndim=1)
+    fz = as_finite_array(fz, "fz", ndim=1)
+    if not (fx.shape == fy.shape == fz.shape):
+        raise ValueError(
+            f"fx, fy and fz must have equal length; got {fx.size}, {fy.size} and {fz.size}"
+        )
+    if fx.size == 0:
+        raise ValueError("fx, fy and fz must hold at least one sample, got 0")
+    if np.any(fz < 0.0):
+        bad = int(np.flatnonzero(fz < 0.0)[0])
+        raise ValueError(
+            f"fz must be >= 0 N (compressive normal force); got {fz[bad]!r} at index {bad}"
+        )
+    return fx, fy, fz
+
+
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(inf|infinity|nan)", re.IGNORECASE)
+
+
+def parse_number(text: str) -> float:
+    """A decimal number written in a text file: ``float`` without its Python-only forms.
+
+    ``float`` also takes ``"1_0"`` (10.0) and surrounding whitespace of any
+    kind; a data file means neither.  Raises ValueError; ``inf`` and ``nan``
+    parse (callers check finiteness with their own message).
+
+    Examples
+    --------
+    >>> parse_number(" 1.5e-3 "), parse_number("-2")
+    (0.0015, -2.0)
+    """
+    stripped = text.strip(" \t")
+    if not _NUMBER.fullmatch(stripped):
+        raise ValueError(f"{text!r} is not a number")
+    return float(stripped)

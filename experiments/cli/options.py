@@ -1,0 +1,169 @@
+"""Command-line options shared by several ``ddmm`` commands: engines, runs, scenes, output files.
+
+Engine choices come from the engine registry (`ddmm.models.engines.registry`):
+a registered engine appears in every ``--engine`` option without an edit here.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from ddmm.experiments.cli.recording_options import (
+    add_recording_options,
+    conditioning_from_args,
+    csv_scene,
+    refuse_csv_options,
+)
+from ddmm.experiments.io import seed_arg
+from ddmm.population.io.arrays import EXTENSIONS
+
+__all__ = ["SCENES", "add_engine_option", "add_run_options", "check_out_file", "parse_contact", "parse_directions",
+           "parse_types", "population_from_args", "scenes_from_args"]
+
+
+def add_engine_option(p, default: str) -> None:
+    """``--engine``, its choices the registered engines, its help each engine's summary."""
+    from ddmm.models.engines.registry import engine_names, get_engine
+
+    summaries = "; ".join(f"{name}: {get_engine(name).summary}" for name in engine_names())
+    p.add_argument("--engine", choices=engine_names(), default=default,
+                   help=f"the engine that integrates the neurons (default {default}). {summaries}")
+
+
+SCENES = ("birznieks", "press-push-lift", "rotating-shear")
+
+
+def add_run_options(p, *, out_required: bool) -> None:
+    """The options of ``ddmm simulate`` and ``ddmm plan``: population, scene, engine, step, trials, output."""
+    p.add_argument("--population", default="fingertip", help="fingertip, hand or a spec .toml file")
+    p.add_argument("--scene", default="birznieks",
+                   help=f"{', '.join(SCENES)}, a force .csv file, or a sensor-array file "
+                        f"({', '.join(EXTENSIONS)}; a long .csv with --sites)")
+    p.add_argument("--sites", default=None, metavar="SITES.csv",
+                   help="sites table (site,x_mm,y_mm[,region][,radius_mm]): --scene is then a long CSV "
+                        "of time,site,fx,fy,fz")
+    p.add_argument("--theta-r", default=None, metavar="DEG[,DEG...]",
+                   help="shear direction(s) in degrees, one condition each ('none': normal only); default 90")
+    p.add_argument("--contact", default=None, metavar="X,Y,R", help="contact centre and radius in mm")
+    add_engine_option(p, "brian2")
+    p.add_argument("--dt", type=float, default=None, metavar="MS", help="integration step in ms (default 0.1)")
+    p.add_argument("--method", choices=("euler", "rk2", "rk4", "izhikevich2003"), default=None,
+                   help="integration scheme (default euler)")
+    p.add_argument("--tolerance", type=float, default=None, metavar="PPS",
+                   help="choose the cheapest dt and method whose mean SF error is within PPS pulses/s")
+    p.add_argument("--trials", type=int, default=1)
+    p.add_argument("--seed", type=seed_arg, default=0, help="seed of the population and the noise (default 0)")
+    p.add_argument("--no-shear", choices=("smooth", "pass", "block"), default="smooth",
+                   help="reading of eq. 17: the continuous transition (default) or the paper's two")
+    p.add_argument("--types", default=None, metavar="T[,T...]", help="afferent types to simulate")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--scheduler", default=None, metavar="processes|ADDRESS",
+                   help="run afferent blocks on Dask: a local pool of processes or a scheduler address")
+    p.add_argument("--out", required=out_required, metavar="FILE.nc")
+    add_recording_options(p)
+
+
+def parse_directions(text, default="90"):
+    """The shear directions of ``--theta-r`` in degrees (None for 'none': normal force only)."""
+    out = []
+    for part in (text or default).split(","):
+        part = part.strip()
+        if part.lower() == "none":
+            out.append(None)
+            continue
+        try:
+            value = float(part)
+        except ValueError:
+            value = float("nan")
+        if not math.isfinite(value):
+            raise ValueError(f"--theta-r: {part!r} is not a finite number of degrees or 'none'")
+        out.append(value)
+    return out
+
+
+def parse_contact(text):
+    """The `Contact` of ``--contact X,Y,R`` (mm), or None."""
+    from ddmm.population import Contact
+    if text is None:
+        return None
+    try:
+        x, y, r = (float(v) for v in text.split(","))
+    except ValueError:
+        raise ValueError(f"--contact must be X,Y,R in mm, got {text!r}") from None
+    return Contact(x, y, r)
+
+
+def _array_scene(args):
+    """The sensor-array scene of ``--scene FILE`` (and ``--sites``), or None for any other ``--scene``."""
+    from ddmm.population import from_array, from_long_csv
+    suffix = Path(args.scene).suffix.lower()
+    is_array = suffix in EXTENSIONS or (suffix == ".csv" and args.sites is not None)
+    if args.sites is not None and suffix != ".csv":
+        raise ValueError(f"--sites goes with a long .csv --scene (time,site,fx,fy,fz), not {args.scene!r}")
+    if not is_array:
+        return None
+    if args.contact is not None:
+        raise ValueError("--contact does not apply to a sensor-array scene: each site has its own footprint")
+    if args.theta_r is not None:
+        raise ValueError("--theta-r does not apply to a sensor-array scene: the file gives the forces")
+    refuse_csv_options(args, args.scene)
+    conditioning = conditioning_from_args(args)
+    if suffix in EXTENSIONS:
+        return from_array(args.scene, conditioning=conditioning)
+    return from_long_csv(args.scene, args.sites, conditioning=conditioning)
+
+
+def scenes_from_args(args) -> list:
+    """The scenes named by ``--scene``, ``--sites``, ``--theta-r`` and ``--contact``."""
+    from ddmm.population import birznieks, press_push_lift, rotating_shear
+    array = _array_scene(args)
+    if array is not None:
+        return [array]
+    contact = parse_contact(args.contact)
+    if args.scene == "birznieks":
+        return [birznieks(d, contact=contact) for d in parse_directions(args.theta_r)]
+    if args.scene == "press-push-lift":
+        dirs = parse_directions(args.theta_r)
+        if None in dirs:
+            raise ValueError("--theta-r none is only meaningful for the birznieks scene")
+        return [press_push_lift(d, contact=contact) for d in dirs]
+    if args.scene == "rotating-shear":
+        start = parse_directions(args.theta_r, default="0")
+        return [rotating_shear(start_deg=start[0] or 0.0, contact=contact)]
+    if args.scene.lower().endswith(".csv"):
+        if args.theta_r is not None:
+            raise ValueError(f"--theta-r does not apply to the recorded scene {args.scene!r}: the file gives the "
+                             "forces")
+        return [csv_scene(args.scene, args, contact)]
+    raise ValueError(f"--scene {args.scene!r} is unknown; allowed: {', '.join(SCENES)}, a .csv file or a "
+                     f"sensor-array file ({', '.join(EXTENSIONS)})")
+
+
+def parse_types(text):
+    """The afferent types of ``--types T[,T...]`` as a tuple, or None for all."""
+    return None if text is None else tuple(t.strip() for t in text.split(","))
+
+
+def population_from_args(args):
+    """The population of ``--population`` (a preset or a spec file), sampled with ``--seed``."""
+    from ddmm.population import load_spec, sample_population
+    return sample_population(load_spec(args.population), rng=args.seed)
+
+
+def check_out_file(path, suffix: str = ".nc", option: str = "--out") -> Path:
+    """Fail before the work if ``path`` cannot be written (a probe file is created)."""
+    import tempfile
+
+    path = Path(path)
+    if path.suffix != suffix:
+        raise ValueError(f"{option} {str(path)!r} must end in {suffix}")
+    if not path.parent.is_dir():
+        raise ValueError(f"{option} {str(path)!r}: directory {str(path.parent)!r} does not exist")
+    try:
+        with tempfile.NamedTemporaryFile(dir=path.parent, prefix=".ddmm-probe-"):
+            pass
+    except OSError as exc:
+        raise ValueError(f"{option} {str(path)!r}: directory {str(path.parent)!r} is not writable "
+                         f"({exc.strerror})") from None
+    return path

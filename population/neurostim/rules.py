@@ -1,0 +1,198 @@
+"""Encoding rules: from afferent activity or force under a field to a pulse rate and amplitude.
+
+Each rule sets, at every model sample (1 / fs), a **commanded pulse rate**
+and a **commanded amplitude** per electrode; `ddmm.population.neurostim.pulses`
+turns the commands into pulses within the electrode's limits.  Every rule
+emits nothing while the force under the field is at or below the contact
+threshold (0.05 N, `ddmm.models.metrics.CONTACT_THRESHOLD`).
+
+**biomimetic** (`Biomimetic`), after the biomimetic encoders of Okorokova et
+al. (2018), Valle et al. (2018) and George et al. (2019) (Okorokova's abstract read,
+the others recalled: docs/references.md).  The pulse rate follows the aggregate firing rate of the
+afferents in the electrode's projected field, and the amplitude follows how
+many of them are active, so that stimulation recruits more fibres when more
+afferents would fire:
+
+* aggregate rate ``r`` (spikes/s per field afferent): the weighted spike count
+  of the field's afferents per sample, divided by their number, smoothed by a
+  causal exponential of time constant ``tau_s``.  Okorokova et al. (2018;
+  abstract read) drive stimulation by the time-varying *population* firing
+  rate, so by default every spike counts once (``weights`` 1 for each type):
+  the FA-I and FA-II bursts at contact onset and offset are the transients,
+  as they are in the nerve.  ``weights`` can stress them further;
+* rate command ``max_rate_hz x min(r / rate_sat_hz, 1)``;
+* active fraction ``a``: field afferents that fired in the last
+  ``active_window_s``, over their number; amplitude command
+  ``amplitude_min_ua + (amplitude_max_ua - amplitude_min_ua) x min(a / active_sat, 1)``.
+
+**linear-amplitude** (`LinearAmplitude`): a fixed rate ``rate_hz`` (at most the
+electrode's limit), amplitude rising linearly from ``amplitude_min_ua`` at the
+contact threshold to ``amplitude_max_ua`` at ``force_sat_n`` under the field.
+
+**linear-frequency** (`LinearFrequency`): a fixed amplitude (``amplitude_fraction``
+of the way from the minimum to the maximum), rate rising linearly from 0 at the
+contact threshold to ``max_rate_hz`` at ``force_sat_n``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ddmm.utils.validation import shown
+from ddmm.models.afferent_types import AFFERENT_TYPES as TYPES
+
+__all__ = ["Biomimetic", "LinearAmplitude", "LinearFrequency", "RULES", "get_rule"]
+
+
+def _positive(rule: str, name: str, value, upper: float | None = None) -> None:
+    number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if not number or not math.isfinite(value) or value <= 0 or (upper is not None and value > upper):
+        shown = f"{float(value):g}" if number else repr(value)
+        raise ValueError(f"{rule}: {name} must be a finite number > 0{'' if upper is None else f' and <= {upper:g}'}, "
+                         f"got {shown}")
+
+
+@dataclass(frozen=True)
+class Biomimetic:
+    """The biomimetic rule (module docstring).
+
+    Attributes
+    ----------
+    tau_s : float
+        Time constant of the aggregate rate's smoothing, s.
+    rate_sat_hz : float
+        Aggregate rate (spikes/s per field afferent) at which the pulse rate
+        reaches the electrode's limit.
+    active_window_s : float
+        An afferent is active for this long after each of its spikes, s.
+    active_sat : float
+        Active fraction at which the amplitude reaches its maximum (0-1].
+    weights : tuple of (str, float)
+        Weight of each type's spikes in the aggregate rate.
+
+    Examples
+    --------
+    >>> Biomimetic().code
+    0
+    """
+
+    tau_s: float = 0.02
+    rate_sat_hz: float = 100.0
+    active_window_s: float = 0.02
+    active_sat: float = 0.5
+    weights: tuple = (("SAI", 1.0), ("RAI", 1.0), ("RAII", 1.0), ("SAII", 1.0))
+    name = "biomimetic"
+    code = 0
+
+    def __post_init__(self):
+        for field in ("tau_s", "rate_sat_hz", "active_window_s"):
+            _positive(self.name, field, getattr(self, field))
+        _positive(self.name, "active_sat", self.active_sat, 1.0)
+        weights = dict(self.weights)
+        if set(weights) != set(TYPES) or any(not (isinstance(w, (int, float)) and math.isfinite(w) and w >= 0)
+                                             for w in weights.values()):
+            raise ValueError(f"{self.name}: weights must give a finite weight >= 0 to each of {', '.join(TYPES)}, "
+                             f"got {self.weights!r}")
+
+    def type_weights(self, afferent_type) -> np.ndarray:
+        """The weight of each afferent's spikes."""
+        weights = dict(self.weights)
+        return np.array([weights[t] for t in np.asarray(afferent_type).astype(str)], dtype=float)
+
+    def params(self) -> np.ndarray:
+        """The kernel's parameter vector (`ddmm.population.neurostim.pulses`)."""
+        return np.array([self.tau_s, self.rate_sat_hz, self.active_window_s, self.active_sat, 0.0, 0.0, 0.0])
+
+
+@dataclass(frozen=True)
+class LinearAmplitude:
+    """The linear-amplitude baseline: fixed rate, amplitude linear in the force under the field.
+
+    Attributes
+    ----------
+    rate_hz : float
+        Pulse rate in contact, Hz (each electrode's limit caps it).
+    force_sat_n : float
+        Force under the field at which the amplitude reaches its maximum, N.
+
+    Examples
+    --------
+    >>> LinearAmplitude(rate_hz=50.0).name
+    'linear-amplitude'
+    """
+
+    rate_hz: float = 100.0
+    force_sat_n: float = 5.0
+    name = "linear-amplitude"
+    code = 1
+
+    def __post_init__(self):
+        _positive(self.name, "rate_hz", self.rate_hz)
+        _positive(self.name, "force_sat_n", self.force_sat_n)
+
+    def type_weights(self, afferent_type) -> np.ndarray:
+        """Unused by this rule (no afferent activity): ones."""
+        return np.ones(len(afferent_type))
+
+    def params(self) -> np.ndarray:
+        """The kernel's parameter vector."""
+        return np.array([1.0, 1.0, 1.0, 1.0, self.rate_hz, self.force_sat_n, 0.0])
+
+
+@dataclass(frozen=True)
+class LinearFrequency:
+    """The linear-frequency baseline: fixed amplitude, rate linear in the force under the field.
+
+    Attributes
+    ----------
+    amplitude_fraction : float
+        Where the fixed amplitude sits between the electrode's minimum (0) and maximum (1).
+    force_sat_n : float
+        Force under the field at which the rate reaches the electrode's limit, N.
+
+    Examples
+    --------
+    >>> LinearFrequency().amplitude_fraction
+    0.5
+    """
+
+    amplitude_fraction: float = 0.5
+    force_sat_n: float = 5.0
+    name = "linear-frequency"
+    code = 2
+
+    def __post_init__(self):
+        number = isinstance(self.amplitude_fraction, (int, float)) and not isinstance(self.amplitude_fraction, bool)
+        if not number or not 0.0 <= self.amplitude_fraction <= 1.0:
+            raise ValueError(f"{self.name}: amplitude_fraction must be in [0, 1], got {shown(self.amplitude_fraction)}")
+        _positive(self.name, "force_sat_n", self.force_sat_n)
+
+    def type_weights(self, afferent_type) -> np.ndarray:
+        """Unused by this rule (no afferent activity): ones."""
+        return np.ones(len(afferent_type))
+
+    def params(self) -> np.ndarray:
+        """The kernel's parameter vector."""
+        return np.array([1.0, 1.0, 1.0, 1.0, 0.0, self.force_sat_n, self.amplitude_fraction])
+
+
+#: The rules by name, each with its default settings.
+RULES = {rule.name: rule for rule in (Biomimetic, LinearAmplitude, LinearFrequency)}
+
+
+def get_rule(rule):
+    """A rule object from a rule or its name.
+
+    Examples
+    --------
+    >>> get_rule("linear-frequency").name
+    'linear-frequency'
+    """
+    if isinstance(rule, (Biomimetic, LinearAmplitude, LinearFrequency)):
+        return rule
+    if isinstance(rule, str) and rule in RULES:
+        return RULES[rule]()
+    raise ValueError(f"rule={rule!r} is unknown; allowed: {', '.join(RULES)} or a rule object")
