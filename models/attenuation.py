@@ -35,8 +35,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 from ddmm.models.nap import get_profile, radius_scalar, tip_radius, validate_k
+from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 
 __all__ = [
     "F_TH",

@@ -3,7 +3,7 @@
 Derivatives of a raw force signal are useless, so each type's drive is
 low-passed by a *causal* Butterworth filter (with RA-II's optional
 high-pass) before its backward differences.  SciPy designs the sections,
-kept on disk by their exact arguments (`lowpass_sos`); `stage_constants`
+kept on disk by their exact arguments (`lowpass_sos`); `type_filter_constants`
 caches a type's sections and coefficients per (params, type, rate);
 `FilterState` carries a stage's state from one chunk to the next, so chunked
 and whole signals give the same bits; `check_fs` refuses a scene sampled too
@@ -18,20 +18,22 @@ from functools import lru_cache
 
 import numpy as np
 
-from ddmm.utils.cache import cache_root
 from ddmm.models._stage_kernels import stage_kernel
-from ddmm.utils.validation import as_finite_array, check_positive
 from ddmm.models.afferent_types import AFFERENT_TYPES
-from ddmm.models.current_params import CurrentParams, CurrentStage
+from ddmm.models.current_params import CurrentParams, TypeCurrentParams
+from ddmm.utils.cache import cache_root
+from ddmm.utils.deprecation import renamed_keyword
+from ddmm.utils.validation import as_finite_array, check_positive
 
 __all__ = ["RAII_FS_FACTOR", "FilterState", "check_fs", "filter_force", "initial_filter_state", "lowpass_sos",
-           "stage_constants"]
+           "type_filter_constants"]
 
 #: A scene must be sampled at least this many times faster than RA-II's cut-off.
 RAII_FS_FACTOR = 2.5
 
 
-def check_fs(fs: float, params: CurrentParams, types=AFFERENT_TYPES) -> None:
+@renamed_keyword("types", "afferent_types")
+def check_fs(fs: float, params: CurrentParams, afferent_types=AFFERENT_TYPES) -> None:
     """Refuse a sample rate too slow for a type's filter band.
 
     RA-II's stage needs ``fs >= 2.5 * cutoff`` (its band must sit well below
@@ -42,8 +44,8 @@ def check_fs(fs: float, params: CurrentParams, types=AFFERENT_TYPES) -> None:
     ValueError
         Naming the type, its band and the rate needed.
     """
-    for kind in types:
-        stage = params.stage(kind)
+    for kind in afferent_types:
+        stage = params.for_type(kind)
         if stage.cutoff_hz is None:
             continue
         if kind == "RAII":
@@ -53,7 +55,7 @@ def check_fs(fs: float, params: CurrentParams, types=AFFERENT_TYPES) -> None:
         if too_slow or stage.cutoff_hz >= fs / 2.0:
             raise ValueError(
                 f"fs={fs:g} Hz is too slow for {kind}: its band reaches {stage.cutoff_hz:g} Hz, which needs force "
-                f"sampled {need}; resample the scene faster (from_csv(fs=...)) or leave {kind} out (types=...)"
+                f"sampled {need}; resample the scene faster (from_csv(fs=...)) or leave {kind} out (afferent_types=...)"
             )
 
 
@@ -142,7 +144,7 @@ def _filter_cache():
 _PASS_THROUGH = np.array([[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]])  # an identity section: no filter
 
 
-def _stage_sos(stage: CurrentStage, fs: float) -> np.ndarray:
+def _stage_sos(stage: TypeCurrentParams, fs: float) -> np.ndarray:
     if stage.cutoff_hz is None:
         return _PASS_THROUGH
     if not stage.cutoff_hz < fs / 2.0:
@@ -167,7 +169,7 @@ def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams(),
     (F_A = 0) is unaffected.  ``afferent_type`` selects the stage's filter.
     """
     f0 = np.atleast_1d(np.asarray(f0, dtype=float)).copy()
-    sos = _stage_sos(params.stage(afferent_type), fs)
+    sos = _stage_sos(params.for_type(afferent_type), fs)
     zeros = np.zeros_like(f0)
     return FilterState(zi=np.zeros((sos.shape[0], 2, f0.size)), offset=f0, y1=zeros, y2=zeros.copy(),
                        slow=zeros.copy(), smooth=zeros.copy(), dyn=zeros.copy())
@@ -199,7 +201,7 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
         State after the last sample.
     """
     f_a = as_finite_array(f_a, "f_a", ndim=2)
-    shared = CurrentStage("RAI", 0, params.cutoff_hz, params.filter_order, 0.0, 1.0, 1.0, None, None, 0.0)
+    shared = TypeCurrentParams("RAI", 0, params.cutoff_hz, params.filter_order, 0.0, 1.0, 1.0, None, None, 0.0)
     if state is None:
         state = initial_filter_state(f_a[0], fs, params)
     m = f_a.shape[1]
@@ -212,10 +214,19 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
 
 
 @lru_cache(maxsize=256)
-def stage_constants(params: CurrentParams, afferent_type: str, fs: float):
+def type_filter_constants(params: CurrentParams, afferent_type: str, fs: float):
     """(stage, filter sections, adaptation and smoothing coefficients), cached: per call they would
     cost a short chunk more than its arithmetic."""
-    stage = params.stage(afferent_type)
+    stage = params.for_type(afferent_type)
     alpha_adapt = float(-np.expm1(-1.0 / (fs * stage.tau_adapt_s)))
     alpha_smooth = 0.0 if stage.tau_s is None else float(-np.expm1(-1.0 / (fs * stage.tau_s)))
     return stage, _stage_sos(stage, fs), alpha_adapt, alpha_smooth
+
+
+def stage_constants(params: CurrentParams, afferent_type: str, fs: float):
+    """Deprecated name of `type_filter_constants` ("stage" names a scene's interval)."""
+    import warnings
+
+    warnings.warn("stage_constants() is deprecated and will be removed in the next release; use "
+                  "type_filter_constants()", DeprecationWarning, stacklevel=2)
+    return type_filter_constants(params, afferent_type, fs)

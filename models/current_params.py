@@ -1,8 +1,8 @@
-"""The parameters of the current stage: `CurrentParams` and the per-type `CurrentStage` it resolves to.
+"""The parameters of the current stage: `CurrentParams` and the per-type `TypeCurrentParams` it resolves to.
 
 `CurrentParams` holds every gain, filter and transducer of the four types,
-validated when built; `CurrentParams.stage` resolves one type's fields into a
-`CurrentStage`, which the stage arithmetic (`ddmm.models.currents`) and the
+validated when built; `CurrentParams.for_type` resolves one type's fields into a
+`TypeCurrentParams`, which the stage arithmetic (`ddmm.models.currents`) and the
 fused pipeline (`ddmm.models.fused`) consume.  The model these fields
 parametrise, and which of them depart from the paper, is described in
 `ddmm.models.currents`.
@@ -10,14 +10,16 @@ parametrise, and which of them depart from the paper, is described in
 
 from __future__ import annotations
 
+import warnings
+
 from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.utils.validation import check_positive, shown
 from ddmm.models.afferent_types import normalize_type
+from ddmm.utils.validation import check_positive, shown
 
-__all__ = ["DERIVATIVE_ORDER", "CurrentParams", "CurrentStage"]
+__all__ = ["DERIVATIVE_ORDER", "CurrentParams", "TypeCurrentParams"]
 
 #: Derivative order of each type's drive: force, velocity, acceleration, stretch.
 DERIVATIVE_ORDER = {"SAI": 0, "RAI": 1, "RAII": 2, "SAII": 0}
@@ -263,15 +265,15 @@ class CurrentParams:
         own = self._own("i_sat", afferent_type)
         return self.i_sat if own is None else own
 
-    def stage(self, afferent_type: str) -> CurrentStage:
-        """The resolved stage of one type: filter, derivative order, transducer."""
+    def for_type(self, afferent_type: str) -> TypeCurrentParams:
+        """The current parameters of one type, resolved: filter, derivative order, transducer."""
         afferent_type = normalize_type(afferent_type)
         cutoff = self._own("cutoff", afferent_type, "_hz")
         if afferent_type in ("RAI", "RAII"):
             cutoff = cutoff or self.cutoff_hz  # the paper's shared low-pass before the derivatives
         order = self.order_raii if afferent_type == "RAII" and self.order_raii is not None else self.filter_order
         tau_adapt = self._own("tau_adapt", afferent_type, "_s", self.tau_adapt_sai_s)
-        return CurrentStage(afferent_type, DERIVATIVE_ORDER[afferent_type], cutoff, order,
+        return TypeCurrentParams(afferent_type, DERIVATIVE_ORDER[afferent_type], cutoff, order,
                             self._own("adapt", afferent_type, default=0.0), tau_adapt, self.gain(afferent_type),
                             self.saturation(afferent_type), self._own("i_max", afferent_type),
                             self._own("bias", afferent_type, default=0.0), self._own("tau", afferent_type, "_s"),
@@ -285,9 +287,16 @@ class CurrentParams:
                             self._own("opponent_shear", afferent_type, default=0.0))
 
 
+    def stage(self, afferent_type: str) -> TypeCurrentParams:
+        """Deprecated name of `for_type` ("stage" names a scene's interval, `ddmm.population.Stage`)."""
+        warnings.warn("CurrentParams.stage() is deprecated and will be removed in the next release; use "
+                      "CurrentParams.for_type()", DeprecationWarning, stacklevel=2)
+        return self.for_type(afferent_type)
+
+
 @dataclass(frozen=True)
-class CurrentStage:
-    """One type's resolved current stage (see `CurrentParams.stage`).
+class TypeCurrentParams:
+    """One type's current parameters, resolved from `CurrentParams` (see `CurrentParams.for_type`).
 
     Attributes
     ----------
@@ -354,3 +363,10 @@ class CurrentStage:
         """Whether the drive keeps its sign (SA-II's stretch) instead of being rectified."""
         return self.afferent_type == "SAII"
 
+
+def __getattr__(name):
+    if name == "CurrentStage":  # the old name, for one release
+        warnings.warn("CurrentStage is deprecated and will be removed in the next release; use TypeCurrentParams",
+                      DeprecationWarning, stacklevel=2)
+        return TypeCurrentParams
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

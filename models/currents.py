@@ -76,7 +76,6 @@ from __future__ import annotations
 import numpy as np
 
 from ddmm.models._stage_kernels import dynamic_kernel, smooth_kernel, stage_kernel, transduce_inplace
-from ddmm.utils.validation import as_finite_array, check_positive
 from ddmm.models.afferent_types import AFFERENT_TYPES, PAPER_TYPES, TYPE_LABELS, normalize_type, type_label
 from ddmm.models.current_filters import (
     _NO_NORMALS,
@@ -86,9 +85,9 @@ from ddmm.models.current_filters import (
     filter_force,
     initial_filter_state,
     lowpass_sos,
-    stage_constants,
+    type_filter_constants,
 )
-from ddmm.models.current_params import DERIVATIVE_ORDER, CurrentParams, CurrentStage  # noqa: F401 (re-exported)
+from ddmm.models.current_params import DERIVATIVE_ORDER, CurrentParams, TypeCurrentParams  # noqa: F401 (re-exported)
 from ddmm.models.variability import (
     BIAS_KEY,  # noqa: F401 (re-exported)
     EXCITE_SAMPLE,  # noqa: F401 (re-exported)
@@ -98,12 +97,13 @@ from ddmm.models.variability import (
     initial_phase,
     tonic_current,
 )
+from ddmm.utils.validation import as_finite_array, check_positive
 
 __all__ = [
     "PAPER_TYPES",
     "AFFERENT_TYPES",
     "CurrentParams",
-    "CurrentStage",
+    "TypeCurrentParams",
     "FilterState",
     "lowpass_sos",
     "initial_filter_state",
@@ -115,7 +115,7 @@ __all__ = [
     "TYPE_LABELS",
     "type_label",
     "normalize_type",
-    "stage_constants",
+    "type_filter_constants",
     "bias_multiplier",
     "tonic_current",
     "initial_phase",
@@ -191,7 +191,7 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     no spread.
     """
     fs = float(fs)
-    st, sos, alpha_adapt, alpha_smooth = stage_constants(params, afferent_type, fs)
+    st, sos, alpha_adapt, alpha_smooth = type_filter_constants(params, afferent_type, fs)
     gain = st.gain if scale is None else st.gain * np.asarray(scale, dtype=float)
     noisy = normals is not None and noise_cv is not None and bool(np.any(np.asarray(noise_cv) > 0))
     if st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None:
@@ -233,3 +233,11 @@ def _receptor_noise(drive, normals, noise_cv, fs):
     """``d (1 + cv xi / sqrt(h))`` on the paper's unfiltered SAI drive, rectified."""
     scale = np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs)
     return np.maximum(drive + drive * (normals.T * scale), 0.0)
+
+
+def __getattr__(name):
+    if name == "CurrentStage":  # the old name, for one release (it warns)
+        from ddmm.models import current_params
+
+        return current_params.CurrentStage
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -94,7 +94,7 @@ from ddmm.models._stage_kernels import (
     transduce_inplace,
 )
 from ddmm.models.attenuation import UNTUNED
-from ddmm.models.currents import excitability, initial_phase, stage_constants, tonic_current
+from ddmm.models.currents import excitability, initial_phase, type_filter_constants, tonic_current
 from ddmm.models.engines import NeuronState, check_integration, check_stability, get_engine, run_checked, substeps_for
 from ddmm.models.engines.direct import BLOCK, METHOD_CODES, integrate_parts, integrate_range, part_bounds, spike_checks
 from ddmm.models.nap import get_profile, tip_radius
@@ -280,7 +280,7 @@ class FusedPipeline:
         Stable ids keying each afferent's noise (default 0..n-1).
     mixing : ndarray, shape (n_sites, n_afferents), optional
         Each afferent's coefficients of the site forces (`mixing_matrix`):
-        the plan then takes site forces and mixes them in its kernel.
+        the pipeline then takes site forces and mixes them in its kernel.
     neuron : dict, optional
         `ddmm.models.neuron.NeuronParams` by type code, overriding
         `NEURON_PARAMS` (both engines integrate with them).
@@ -288,8 +288,8 @@ class FusedPipeline:
     Examples
     --------
     >>> from ddmm.models.currents import CurrentParams
-    >>> plan = FusedPipeline(["SAI"], ["none"], [0.0], [1.0], [1.0], [0.0], [0.0], CurrentParams(), 1000.0, "pass", 0.1)
-    >>> plan.currents(np.array([[0.0, 0.0, 2.0]]), plan.new_state(), False).shape
+    >>> pipe = FusedPipeline(["SAI"], ["none"], [0.0], [1.0], [1.0], [0.0], [0.0], CurrentParams(), 1000.0, "pass", 0.1)
+    >>> pipe.currents(np.array([[0.0, 0.0, 2.0]]), pipe.new_state(), False).shape
     (1, 1)
     """
 
@@ -308,7 +308,7 @@ class FusedPipeline:
         change = (afferent_type[1:] != afferent_type[:-1]) | ((nap[1:] == UNTUNED) != (nap[:-1] == UNTUNED))
         bounds = np.flatnonzero(np.r_[True, change, True])  # runs of one type, tuned or not
         spans = list(zip(bounds[:-1], bounds[1:]))
-        consts = [stage_constants(params, str(afferent_type[a]), self.fs) for a, _ in spans]
+        consts = [type_filter_constants(params, str(afferent_type[a]), self.fs) for a, _ in spans]
         noise_cv, noise_sigma = np.asarray(noise_cv, dtype=float), np.asarray(noise_sigma, dtype=float)
         self.aff_f = self._afferent_tables(afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma,
                                                        spans, consts)
@@ -424,7 +424,7 @@ class FusedPipeline:
     def _drive(self, forces, state, started, sample0, key, bounds=None, out=None):
         noisy, mixed = key is not None, self.mixing is not None
         if forces.ndim != (3 if mixed else 2):
-            raise ValueError(f"forces must be {'(n, n_sites, 3) site forces' if mixed else '(n, 3)'} for this plan, "
+            raise ValueError(f"forces must be {'(n, n_sites, 3) site forces' if mixed else '(n, 3)'} for this pipeline, "
                              f"got shape {forces.shape}")
         args = (_NO_FORCES if mixed else forces, forces if mixed else _NO_SITES, self.mixing if mixed else _NO_WEIGHTS,
                 mixed, np.uint64(key or 0), noisy, self.afferent_id, int(sample0), state, started, self.aff_f,
@@ -453,7 +453,7 @@ class FusedPipeline:
     def currents(self, forces, state, started, sample0=0, key=None):
         """Currents (mV/ms), shape (n_samples, n_afferents), of forces in newtons.
 
-        ``forces`` is (n_samples, 3), felt by every afferent, or for a plan
+        ``forces`` is (n_samples, 3), felt by every afferent, or for a pipeline
         with a ``mixing`` the site forces (n_samples, n_sites, 3); long inputs
         run in slices of time of `_SLICE` elements, with the same result.
         ``state`` is updated in place; ``started`` is False on the first

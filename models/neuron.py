@@ -23,9 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.utils.validation import shown
-
 from ddmm.models.currents import AFFERENT_TYPES, normalize_type
+from ddmm.utils.validation import shown
 
 __all__ = [
     "V_PEAK",

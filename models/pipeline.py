@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.utils.validation import check_forces, check_positive
 from ddmm.models.afferent_types import AFFERENT_TYPES
 from ddmm.models.attenuation import (
     F_TH,
@@ -21,6 +20,7 @@ from ddmm.models.attenuation import (
 from ddmm.models.current_params import CurrentParams
 from ddmm.models.currents import afferent_current
 from ddmm.models.engines import SpikeResult, integrate
+from ddmm.utils.validation import check_forces, check_positive
 
 __all__ = ["compute_currents", "simulate_afferents"]
 
@@ -90,7 +90,7 @@ def compute_currents(
     drive = attenuated_force(fz, af)
     for kind in ("SAI", "RAI", "RAII"):  # the presets' shear-magnitude term (0 by default: F_A as it is)
         cols = np.flatnonzero(types == kind)
-        stage = current_params.stage(kind)
+        stage = current_params.for_type(kind)
         if cols.size and stage.shear != 0.0:
             raw = profile_factor(fx, fy, theta[cols], profile, np.broadcast_to(k, theta.shape)[cols])
             drive[:, cols] = shear_drive(drive[:, cols], fx, fy, raw, stage.shear, stage.opponent_shear)

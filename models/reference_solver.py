@@ -17,9 +17,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from ddmm.utils.validation import shown
-
 from ddmm.models.neuron import V_PEAK
+from ddmm.utils.validation import shown
 
 __all__ = ["reference_spike_times"]
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models.current_params import CurrentStage
+from ddmm.models.current_params import TypeCurrentParams
 
 __all__ = ["BIAS_KEY", "EXCITE_SAMPLE", "PHASE_TAG", "bias_multiplier", "excitability", "initial_phase",
            "tonic_current"]
@@ -41,7 +41,7 @@ def bias_multiplier(bias_cv: float, afferent_id) -> np.ndarray:
     return np.exp(np.sqrt(s2) * normals(BIAS_KEY, ids, 0, 1)[:, 0] - s2 / 2.0)
 
 
-def tonic_current(stage: CurrentStage, afferent_id, m: int):
+def tonic_current(stage: TypeCurrentParams, afferent_id, m: int):
     """Each afferent's tonic current (mV/ms): ``stage.bias``, times `bias_multiplier` when spread."""
     if stage.bias_cv == 0.0 or afferent_id is None:
         return np.full(m, stage.bias)

@@ -35,8 +35,6 @@ from pathlib import Path
 
 import numba as nb
 import numpy as np
-
-from ddmm.utils.validation import shown
 import xarray as xr
 
 from ddmm.models.attenuation import F_TH
@@ -44,6 +42,7 @@ from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.models.neuron import NEURON_PARAMS, V_PEAK
 from ddmm.population.anatomy.receptive_fields import RF_SIGMA_MM, RF_SUPPORT
 from ddmm.utils.files import read_netcdf, write_netcdf
+from ddmm.utils.validation import shown
 
 __all__ = ["build_dataset", "save_dataset", "load_dataset", "binned_counts", "binned_rates", "psth",
            "describe_dataset", "cf_attrs", "TIME_ATTRS"]

@@ -18,20 +18,21 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.utils.executors import shared_executor
-from ddmm.utils.resources import check_memory
-from ddmm.utils.validation import check_choice, check_positive, shown
 from ddmm.models.attenuation import F_TH, NO_SHEAR_READINGS
 from ddmm.models.current_filters import check_fs
 from ddmm.models.engines import METHODS, get_engine, prepare, substeps_for
 from ddmm.models.fused import FusedPipeline, mixing_matrix
-from ddmm.utils.extras import require
 from ddmm.population.anatomy.receptive_fields import frame_theta, local_mixing
 from ddmm.population.runtime.noise import noise_key, root_seed
 from ddmm.population.runtime.plan import _BYTES_PER_ELEMENT as _PLAN_BYTES_PER_ELEMENT
 from ddmm.population.runtime.plan import RECORD_CHOICES, make_plan
 from ddmm.population.sampling import Population
 from ddmm.population.stimuli.scenes import Scene
+from ddmm.utils.deprecation import renamed_keyword
+from ddmm.utils.executors import shared_executor
+from ddmm.utils.extras import require
+from ddmm.utils.resources import check_memory
+from ddmm.utils.validation import check_choice, check_positive, shown
 
 __all__ = ["SimConfig", "ChunkJob", "run_chunk", "simulate", "plan_run", "population_currents", "block_pipeline",
            "chunk_forces", "default_chunk_size"]
@@ -243,12 +244,13 @@ def _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_si
     return scenes
 
 
-def plan_run(population, scenes, *, trials=1, record=RECORD_CHOICES, no_shear="smooth", types=None,
+@renamed_keyword("types", "afferent_types")
+def plan_run(population, scenes, *, trials=1, record=RECORD_CHOICES, no_shear="smooth", afferent_types=None,
              chunk_size=None, time_chunk=2000, plan=True, engine="brian2", scheduler=None):
     """The `Plan` that `simulate` would follow (print it with ``plan.describe``)."""
     scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
     chunk_size = default_chunk_size(engine, scheduler) if chunk_size is None else chunk_size
-    return make_plan(population, scenes, types=types, trials=trials, record=record, no_shear=no_shear,
+    return make_plan(population, scenes, afferent_types=afferent_types, trials=trials, record=record, no_shear=no_shear,
                      chunk_size=chunk_size, time_chunk=time_chunk, enabled=plan)
 
 
@@ -322,8 +324,9 @@ def _expand(cond, members, the_plan, block, deterministic, result):
             np.tile(step[source], n_trials))
 
 
+@renamed_keyword("types", "afferent_types")
 def simulate(population, scenes, *, engine="brian2", dt=None, method=None, tolerance=None, trials=1, seed=None,
-             record=RECORD_CHOICES, no_shear="smooth", types=None, plan=True, chunk_size=None,
+             record=RECORD_CHOICES, no_shear="smooth", afferent_types=None, plan=True, chunk_size=None,
              time_chunk=2000, scheduler=None, quiet=False):
     """Simulate a population on one or more scenes.
 
@@ -352,7 +355,7 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
     no_shear : {"pass", "block", "smooth"}
         Reading of eq. 17: the continuous transition ("smooth", default), or
         the paper's two (`ddmm.models.attenuation`).
-    types : sequence of str, optional
+    afferent_types : sequence of str, optional
         Afferent types to simulate (default: all).
     plan : bool
         Skip what provably does not matter (default); False runs everything.
@@ -390,8 +393,8 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
     dt, method, choice = _resolve_step(dt, method, tolerance, scenes)
     scenes = _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_size, time_chunk)
     config = SimConfig(engine, float(dt), method, no_shear, root_seed(seed), int(time_chunk))
-    the_plan = plan_run(population, scenes, trials=trials, record=record, no_shear=no_shear, types=types,
-                        chunk_size=chunk_size, time_chunk=time_chunk, plan=plan, engine=engine,
+    the_plan = plan_run(population, scenes, trials=trials, record=record, no_shear=no_shear,
+                        afferent_types=afferent_types, chunk_size=chunk_size, time_chunk=time_chunk, plan=plan, engine=engine,
                         scheduler=scheduler)
     check_fs(scenes[0].fs, population.current, tuple(sorted(set(population.afferent_type[the_plan.selected].tolist()))))
     _check_run_memory(population, scenes, the_plan, trials)

@@ -49,7 +49,6 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from ddmm.utils.validation import shown
 from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import UNTUNED
 from ddmm.models.current_params import CurrentParams
@@ -57,6 +56,8 @@ from ddmm.models.nap import PROFILE_NAMES
 from ddmm.models.neuron import NEURON_PARAMS, NeuronParams, check_neuron
 from ddmm.population.anatomy import hand_map
 from ddmm.population.anatomy.receptive_fields import check_shape
+from ddmm.utils.deprecation import renamed_keyword
+from ddmm.utils.validation import shown
 
 __all__ = [
     "NAP_CHOICES",
@@ -251,9 +252,10 @@ class MapSpec:
         """The regions populated, in map order."""
         return self.regions or hand_map.region_names()
 
-    def counts(self, types) -> dict:
+    @renamed_keyword("types", "afferent_types")
+    def counts(self, afferent_types) -> dict:
         """Afferents per region and type, {region: {type: count}} (`hand_map.region_counts`)."""
-        return hand_map.region_counts(tuple(types), self.region_names())
+        return hand_map.region_counts(tuple(afferent_types), self.region_names())
 
 
 @dataclass(frozen=True)

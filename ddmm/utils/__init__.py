@@ -12,7 +12,8 @@ imports nothing else of ddmm.
 - `files`: `atomic_write` and the netCDF helpers: no half-written file;
 - `cache`: `cache_root`, the on-disk cache of Brian2 builds and designed filters;
 - `extras`: `require` and `MissingExtraError` for optional dependencies;
-- `lazy`: `lazy_exports`, the PEP 562 names every package ``__init__`` uses.
+- `lazy`: `lazy_exports`, the PEP 562 names every package ``__init__`` uses;
+- `deprecation`: `renamed_keyword`, an old keyword accepted for one release with a warning.
 """
 
 from ddmm.utils.lazy import lazy_exports
@@ -24,6 +25,7 @@ _WHERE = {
     "files": ("atomic_write", "read_netcdf", "sweep_stale_parts", "writable_parent", "write_netcdf"),
     "cache": ("cache_root", "private_dir"),
     "extras": ("MissingExtraError", "require"),
+    "deprecation": ("renamed_keyword",),
     "lazy": ("lazy_exports",),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

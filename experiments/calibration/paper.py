@@ -39,6 +39,7 @@ from ddmm.experiments.paper.cells import _paper, type_cells
 from ddmm.experiments.paper.reproduce import ReproConfig
 from ddmm.models.afferent_types import PAPER_TYPES
 from ddmm.models.current_params import CurrentParams
+from ddmm.utils.deprecation import renamed_keyword
 
 __all__ = ["FIT_CELLS", "READINGS", "DEFINITIONS", "type_config", "objective", "fit_type", "calibrate_paper",
            "config_fields", "report"]
@@ -145,15 +146,17 @@ def fit_type(kind: str, reading: str, definition: str, *, seed: int = 0, n_rando
             "config": config, "cells": objective(kind, config)[1]}
 
 
-def calibrate_paper(*, seed: int = 0, n_random: int = 400, types=PAPER_TYPES, engine: str = "direct") -> dict:
+@renamed_keyword("types", "afferent_types")
+def calibrate_paper(*, seed: int = 0, n_random: int = 400, afferent_types=PAPER_TYPES, engine: str = "direct") -> dict:
     """Fit every type under every reading and SF definition; keep each type's best.
 
     Returns ``{"calibration": {type: ReproConfig}, "trials": [fit_type results]}``.
     """
     trials = [fit_type(kind, reading, definition, seed=seed, n_random=n_random, engine=engine)
-              for kind, reading, definition in itertools.product(types, READINGS, DEFINITIONS)]
-    best = {kind: min((t for t in trials if t["type"] == kind), key=lambda t: t["objective"]) for kind in types}
-    return {"calibration": {kind: best[kind]["config"] for kind in types}, "trials": trials}
+              for kind, reading, definition in itertools.product(afferent_types, READINGS, DEFINITIONS)]
+    best = {kind: min((t for t in trials if t["type"] == kind), key=lambda t: t["objective"])
+            for kind in afferent_types}
+    return {"calibration": {kind: best[kind]["config"] for kind in afferent_types}, "trials": trials}
 
 
 def config_fields(config: ReproConfig, kind: str) -> dict:

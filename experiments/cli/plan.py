@@ -17,7 +17,7 @@ def register(sub) -> None:
 def run_plan(args) -> int:
     from ddmm.population import plan_run
     pop, scenes = population_from_args(args), scenes_from_args(args)
-    the_plan = plan_run(pop, scenes, trials=args.trials, no_shear=args.no_shear, types=parse_types(args.types),
+    the_plan = plan_run(pop, scenes, trials=args.trials, no_shear=args.no_shear, afferent_types=parse_types(args.types),
                         engine=args.engine, scheduler=args.scheduler)
     print(the_plan.describe(pop, scenes))
     if args.tolerance is not None:

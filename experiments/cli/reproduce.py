@@ -93,7 +93,7 @@ def _write_figures(out_dir, what, calibration, result) -> list[str]:
         scene_of, angles = FIGURE_SCENES[name]
         for kind, config in calibration.items():
             for profile in PROFILES:
-                data = response_data(scene_of(config), profile, angles, config, types=(kind,))
+                data = response_data(scene_of(config), profile, angles, config, afferent_types=(kind,))
                 bin_s = config.bin_s if config.sf_definition == "peak_bin" else None  # the bins SF counts in
                 fig = plot_response(data, title=f"{name}: {kind}, {profile} (no_shear={config.no_shear})", bin_s=bin_s)
                 written.append(str(save_figure(fig, out_dir / f"{name}_{kind}_{profile}.png")))

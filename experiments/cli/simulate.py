@@ -29,7 +29,8 @@ def run_simulate(args) -> int:
     start = time.perf_counter()
     ds = simulate(pop, scenes, engine=args.engine, dt=None if args.dt is None else args.dt * 1e-3,
                   method=args.method, tolerance=args.tolerance, trials=args.trials, seed=args.seed,
-                  no_shear=args.no_shear, types=parse_types(args.types), quiet=args.quiet, scheduler=args.scheduler)
+                  no_shear=args.no_shear, afferent_types=parse_types(args.types), quiet=args.quiet,
+                  scheduler=args.scheduler)
     save_dataset(ds, out)
     if not args.quiet:
         choice = f"; {ds.attrs['tolerance_choice']}" if "tolerance_choice" in ds.attrs else ""

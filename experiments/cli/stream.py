@@ -160,7 +160,8 @@ def _encoder(args, fs, sites):
 
     conditioning = conditioning_from_args(args)
     return Encoder(sample_population(load_spec(args.population), rng=args.seed), fs, dt=args.dt * 1e-3,
-                   engine=args.engine, seed=args.seed, types=parse_types(args.types), contact=parse_contact(args.contact),
+                   engine=args.engine, seed=args.seed, afferent_types=parse_types(args.types),
+                   contact=parse_contact(args.contact),
                    sites=sites, conditioning=conditioning, model_fs=None if conditioning is None else args.model_fs)
 
 

@@ -56,12 +56,12 @@ def with_engine(calibration: dict, engine: str) -> dict:
 
 def _table2(kind: str, config: ReproConfig) -> dict:
     # PRSI is a ratio of responses: the spike count over the contact period (contact_mean) whatever the SF reading
-    sf, _ = scene_sf(config.birznieks(90.0), _PRSI_ANGLES, config, types=(kind,), definition="contact_mean")
+    sf, _ = scene_sf(config.birznieks(90.0), _PRSI_ANGLES, config, afferent_types=(kind,), definition="contact_mean")
     return {("II", p, "PRSI"): float(direction_index(*sf[p][kind])) for p in PROFILES}
 
 
 def _press_push_lift(kind: str, config: ReproConfig, angles) -> dict:
-    sf, _ = scene_sf(config.press_push_lift(90.0), angles, config, types=(kind,))
+    sf, _ = scene_sf(config.press_push_lift(90.0), angles, config, afferent_types=(kind,))
     return {p: np.asarray(sf[p][kind], dtype=float) for p in PROFILES}
 
 

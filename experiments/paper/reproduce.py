@@ -17,6 +17,7 @@ from ddmm.models.engines import integrate, substeps_for
 from ddmm.models.metrics import direction_index, spiking_frequency
 from ddmm.models.pipeline import compute_currents
 from ddmm.population.stimuli.scenes import Scene, birznieks, press_push_lift
+from ddmm.utils.deprecation import renamed_keyword
 
 __all__ = [
     "PROFILES",
@@ -88,7 +89,8 @@ def _model_profile(profile: str) -> str:
     return UNTUNED if profile == "cmm" else profile
 
 
-def scene_sf(scene: Scene, theta_ts, config: ReproConfig = ReproConfig(), profiles=PROFILES, types=PAPER_TYPES,
+@renamed_keyword("types", "afferent_types")
+def scene_sf(scene: Scene, theta_ts, config: ReproConfig = ReproConfig(), profiles=PROFILES, afferent_types=PAPER_TYPES,
              definition: str | None = None):
     """SF (pulses/s) of every profile x type x theta_T on one scene.
 
@@ -102,7 +104,7 @@ def scene_sf(scene: Scene, theta_ts, config: ReproConfig = ReproConfig(), profil
     theta_ts = np.asarray(theta_ts, dtype=float)
     blocks, column_types = [], []
     for profile in profiles:
-        for kind in types:
+        for kind in afferent_types:
             blocks.append(compute_currents(
                 scene.fx, scene.fy, scene.fz, fs=scene.fs, afferent_type=kind,
                 profile=_model_profile(profile), theta_t=theta_ts, k=config.k,
@@ -115,8 +117,8 @@ def scene_sf(scene: Scene, theta_ts, config: ReproConfig = ReproConfig(), profil
     sf = spiking_frequency(result.step, current.shape[1], fz=scene.fz, fs=scene.fs,
                            substeps=substeps_for(scene.fs, config.dt), afferent=result.afferent,
                            definition=definition or config.sf_definition, bin_s=config.bin_s)
-    sf = sf.reshape(len(profiles), len(types), theta_ts.size)
-    table = {p: {t: sf[i, j] for j, t in enumerate(types)} for i, p in enumerate(profiles)}
+    sf = sf.reshape(len(profiles), len(afferent_types), theta_ts.size)
+    table = {p: {t: sf[i, j] for j, t in enumerate(afferent_types)} for i, p in enumerate(profiles)}
     return table, result
 
 
@@ -169,7 +171,9 @@ def reproduce_all(config: ReproConfig = ReproConfig()) -> dict:
     return {"table2": table2(config), "table3": table3(config, sub), "fig8": fig8(config, sf)}
 
 
-def response_data(scene: Scene, profile: str, angles, config: ReproConfig = ReproConfig(), types=PAPER_TYPES) -> dict:
+@renamed_keyword("types", "afferent_types")
+def response_data(scene: Scene, profile: str, angles, config: ReproConfig = ReproConfig(),
+                  afferent_types=PAPER_TYPES) -> dict:
     """Data for a Fig. 6/7 panel: forces, AF(t) and spike times per type and theta_T.
 
     Parameters
@@ -182,19 +186,19 @@ def response_data(scene: Scene, profile: str, angles, config: ReproConfig = Repr
         Conditions, e.g. ``[("aligned", 90.0), ("misaligned", 180.0)]``.
     config : ReproConfig
         Reading, gains and SF definition.
-    types : sequence of str
+    afferent_types : sequence of str
         The paper types to simulate (each condition's ``spikes`` has these keys).
     """
     from ddmm.models.attenuation import attenuation_factor
 
     thetas = [a for _, a in angles]
-    _, result = scene_sf(scene, thetas, config, profiles=(profile,), types=types)
+    _, result = scene_sf(scene, thetas, config, profiles=(profile,), afferent_types=afferent_types)
     af = attenuation_factor(scene.fx, scene.fy, thetas, _model_profile(profile), config.k,
                             no_shear=config.no_shear)
     conditions = []
     for j, (label, theta) in enumerate(angles):
         spikes = {kind: result.time[result.afferent == i * len(angles) + j]
-                  for i, kind in enumerate(types)}
+                  for i, kind in enumerate(afferent_types)}
         conditions.append({"label": f"{profile}, {label} (theta_T = {theta:g} deg)",
                            "af": af[:, j], "spikes": spikes})
     return {"time": scene.time, "forces": {"fx": scene.fx, "fy": scene.fy, "fz": scene.fz},

@@ -56,6 +56,6 @@ def table4(path, calibration: dict, args) -> dict:
         warnings.simplefilter("ignore", SpikeCapWarning)
         for kind in PAPER_TYPES:
             config = dataclasses.replace(calibration[kind], sf_definition="contact_mean")
-            sf, _ = scene_sf(scene, TABLE4_ANGLES, config, types=(kind,))
+            sf, _ = scene_sf(scene, TABLE4_ANGLES, config, afferent_types=(kind,))
             cells += _cells(kind, sf)
     return {"cells": cells, "scene": {"name": scene.name, "fs": scene.fs, "duration_s": scene.duration}}

@@ -10,7 +10,8 @@ from matplotlib.figure import Figure
 
 from ddmm.models.afferent_types import AFFERENT_TYPES, PAPER_TYPES, type_label
 
-__all__ = ["TYPE_COLOURS", "plot_response", "plot_sf_vs_theta", "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces",
+__all__ = ["TYPE_COLOURS", "plot_response", "plot_sf_vs_theta",
+           "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces",
            "plot_dsi_histograms", "plot_preferred_rose", "plot_neurometric", "plot_pareto"]
 
 #: The colour of each afferent type in every figure.

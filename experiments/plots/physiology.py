@@ -69,7 +69,8 @@ def plot_frequency_tuning(data: dict) -> Figure:
     for kind, curve in data.items():
         curve = np.asarray(curve, dtype=float)
         finite = np.isfinite(curve)
-        ax.loglog(np.asarray(FREQUENCIES_HZ)[finite], curve[finite], "o-", color=TYPE_COLOURS[kind], label=type_label(kind))
+        ax.loglog(np.asarray(FREQUENCIES_HZ)[finite], curve[finite], "o-", color=TYPE_COLOURS[kind],
+                  label=type_label(kind))
     # the human best bands (docs/references.md row 8)
     ax.axvspan(8, 64, color=TYPE_COLOURS["RAI"], alpha=0.1)
     ax.axvspan(200, 300, color=TYPE_COLOURS["RAII"], alpha=0.1)

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 from ddmm.models.engines.registry import Engine, engine_names, get_engine, register_engine
 from ddmm.models.neuron import V_FLOOR, V_PEAK, NeuronParams, neuron_arrays, resting_state
+from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 
 __all__ = ["ENGINES", "Engine", "get_engine", "register_engine", "engine_names", "METHODS", "MAX_NEGATIVE_DRIVE_MV",
            "NeuronState", "SpikeResult", "NumericalInstabilityError", "SpikeCapWarning", "substeps_for", "prepare",

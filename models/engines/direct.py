@@ -30,8 +30,8 @@ import os
 import numba as nb
 import numpy as np
 
-from ddmm.utils.executors import shared_executor
 from ddmm.models.neuron import refractory_steps
+from ddmm.utils.executors import shared_executor
 
 __all__ = ["run_direct", "default_threads", "BLOCK", "METHOD_CODES", "integrate_range", "integrate_parts", "part_bounds",
            "spike_checks", "cap_scan"]

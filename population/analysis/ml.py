@@ -27,8 +27,13 @@ import xarray as xr
 
 try:
     from sklearn.base import BaseEstimator, RegressorMixin
-    from sklearn.utils.validation import check_consistent_length, check_is_fitted, check_non_negative
-    from sklearn.utils.validation import column_or_1d, validate_data
+    from sklearn.utils.validation import (
+        check_consistent_length,
+        check_is_fitted,
+        check_non_negative,
+        column_or_1d,
+        validate_data,
+    )
 except ImportError as err:  # pragma: no cover - exercised only without the extra
     raise ImportError("ddmm.population.analysis.ml needs scikit-learn >= 1.6: pip install 'ddmm[ml]'") from err
 

@@ -59,7 +59,8 @@ def _simulate(population, scenes, context):
     from ddmm.population.simulation import simulate
 
     types = tuple(t for t in _TYPES if np.any(population.afferent_type == t))
-    return simulate(population, scenes, engine=context["engine"], seed=context["seed"], quiet=True, types=types)
+    return simulate(population, scenes, engine=context["engine"], seed=context["seed"], quiet=True,
+                    afferent_types=types)
 
 
 def _first_spikes(ds, condition, afferents):

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ddmm.utils.deprecation import renamed_keyword
 from ddmm.utils.validation import shown
 
 __all__ = ["Ellipse", "Polygon", "HandRegion", "KINDS", "TYPES", "DENSITY_PER_CM2", "TYPE_SHARE",
@@ -384,17 +385,18 @@ def _largest_remainder(total: int, shares: dict) -> dict:
     return counts
 
 
-def region_counts(types=TYPES, regions=None) -> dict:
+@renamed_keyword("types", "afferent_types")
+def region_counts(afferent_types=TYPES, regions=None) -> dict:
     """Afferents per region and type: {region: {type: count}}.
 
     The region total is ``DENSITY_PER_CM2[kind] x area`` rounded to the
     nearest whole afferent; it is split between all four types by largest
-    remainder of `TYPE_SHARE`, then only ``types`` are kept (so a type's
+    remainder of `TYPE_SHARE`, then only ``afferent_types`` are kept (so a type's
     counts never depend on which other types are asked for).
 
     Parameters
     ----------
-    types : sequence of str
+    afferent_types : sequence of str
         Afferent types to keep, in any order (returned in `TYPES` order).
     regions : sequence of str or None
         Regions to count (default: all, in map order).
@@ -404,16 +406,16 @@ def region_counts(types=TYPES, regions=None) -> dict:
     >>> region_counts(regions=["D2d"])
     {'D2d': {'SAI': 238, 'RAI': 479, 'RAII': 71, 'SAII': 30}}
     """
-    bad = [t for t in types if t not in TYPES]
-    if bad or isinstance(types, str):
-        raise ValueError(f"types={types!r}: allowed types are {', '.join(TYPES)}")
+    bad = [t for t in afferent_types if t not in TYPES]
+    if bad or isinstance(afferent_types, str):
+        raise ValueError(f"afferent_types={afferent_types!r}: allowed afferent_types are {', '.join(TYPES)}")
     names = region_names() if regions is None else tuple(get_region(r).name for r in regions)
     out = {}
     for name in names:
         region = REGIONS[name]
         total = int(np.floor(DENSITY_PER_CM2[region.kind] * region.area_mm2 / 100.0 + 0.5))
         counts = _largest_remainder(total, TYPE_SHARE)
-        out[name] = {t: counts[t] for t in TYPES if t in types}
+        out[name] = {t: counts[t] for t in TYPES if t in afferent_types}
     return out
 
 

@@ -68,11 +68,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.utils.files import atomic_write
 from ddmm.population.io._long_csv import TIME_TOL, read_long_forces, read_sites_csv, uniform_grid
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.recordings import RECORDED, warn_band
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Scene, Sites, taxel_radius
+from ddmm.utils.files import atomic_write
 
 __all__ = ["EXTENSIONS", "from_array", "save_array", "from_long_csv", "default_radius"]
 

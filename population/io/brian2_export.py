@@ -30,8 +30,8 @@ import numbers
 
 import numpy as np
 
-from ddmm.utils.validation import check_positive
 from ddmm.population.io import _export as ex
+from ddmm.utils.validation import check_positive
 
 __all__ = ["to_brian2"]
 

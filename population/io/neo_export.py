@@ -26,8 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.utils.extras import require
 from ddmm.population.io import _export as ex
+from ddmm.utils.extras import require
 
 __all__ = ["to_neo"]
 

@@ -66,8 +66,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.utils.extras import require
 from ddmm.population.io import _export as ex
+from ddmm.utils.extras import require
 from ddmm.utils.files import atomic_write, writable_parent
 
 __all__ = ["to_nwb", "PAPER_DOI", "REFERENCE_START"]

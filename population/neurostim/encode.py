@@ -27,10 +27,10 @@ import xarray as xr
 
 from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.population.dataset import TIME_ATTRS, cf_attrs
-from ddmm.utils.files import read_netcdf, write_netcdf
 from ddmm.population.neurostim.electrodes import ElectrodeTable, read_electrodes
 from ddmm.population.neurostim.pulses import PulseKernel, contact_weights, field_weights
 from ddmm.population.neurostim.rules import get_rule
+from ddmm.utils.files import read_netcdf, write_netcdf
 
 __all__ = ["stimulation_pulses", "check_pulses", "save_pulses", "load_pulses", "as_table", "WAVEFORM"]
 

@@ -41,8 +41,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.utils.validation import shown
 from ddmm.models.afferent_types import AFFERENT_TYPES as TYPES
+from ddmm.utils.validation import shown
 
 __all__ = ["Biomimetic", "LinearAmplitude", "LinearFrequency", "RULES", "get_rule"]
 

@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.utils.validation import check_positive, shown
-from ddmm.utils.extras import require
 from ddmm.population.stimuli.recordings import UNITS
+from ddmm.utils.extras import require
+from ddmm.utils.validation import check_positive, shown
 
 __all__ = ["SPIKE_STREAM_TYPE", "FORCE_STREAM_TYPE", "PULSE_STREAM_TYPE", "ForceStream", "ChunkReader",
            "open_force_stream", "open_force_outlet", "lsl_clock"]

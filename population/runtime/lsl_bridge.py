@@ -26,8 +26,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ddmm.utils.validation import check_positive
 from ddmm.population.runtime.lsl import ChunkReader, ForceStream, _pylsl
+from ddmm.utils.validation import check_positive
 
 __all__ = ["GAP_FACTOR", "BridgeSummary", "Bridge", "check_stamps", "play_forces"]
 

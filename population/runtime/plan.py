@@ -31,11 +31,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.utils.validation import check_choice
 from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import F_TH, UNTUNED
 from ddmm.models.variability import bias_multiplier
 from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
+from ddmm.utils.deprecation import renamed_keyword
+from ddmm.utils.validation import check_choice
 
 __all__ = ["RECORD_CHOICES", "ConditionPlan", "Plan", "af_threshold", "make_plan"]
 
@@ -54,7 +55,7 @@ class ConditionPlan:
         Condition name.
     n_samples : int
         Force samples.
-    af_stage : bool
+    computes_af : bool
         Whether AF is computed (False: AF is constant).
     af_constant : float
         AF of tuned afferents when the stage is skipped (1 pass, 0 block).
@@ -69,11 +70,20 @@ class ConditionPlan:
 
     name: str
     n_samples: int
-    af_stage: bool
+    computes_af: bool
     af_constant: float
     weights: np.ndarray | None
     units: np.ndarray
     member_unit: np.ndarray
+
+    @property
+    def af_stage(self) -> bool:
+        """Deprecated name of `computes_af` ("stage" names a scene's interval)."""
+        import warnings
+
+        warnings.warn("ConditionPlan.af_stage is deprecated and will be removed in the next release; use "
+                      "computes_af", DeprecationWarning, stacklevel=2)
+        return self.computes_af
 
     @property
     def noisy(self) -> np.ndarray:
@@ -161,7 +171,7 @@ def _by_region(population, plan, cond) -> str:
 
 
 def _af_note(cond: ConditionPlan) -> str:
-    if cond.af_stage:
+    if cond.computes_af:
         return "computed"
     return f"skipped (no shear that changes AF; AF = {cond.af_constant:g})"
 
@@ -186,10 +196,10 @@ def af_threshold(no_shear: str) -> float:
     return 0.0 if no_shear == "smooth" else F_TH
 
 
-def _quiet(pop, sel, scene, scale, af_stage, af_constant):
+def _quiet(pop, sel, scene, scale, computes_af, af_constant):
     """Afferents whose noise-free current is identically zero (they never leave rest)."""
     stretch = pop.afferent_type[sel] == "SAII"
-    blocked = (pop.nap[sel] != UNTUNED) & (not af_stage) & (af_constant == 0.0)
+    blocked = (pop.nap[sel] != UNTUNED) & (not computes_af) & (af_constant == 0.0)
     sheared = _shear_gained(pop, sel) & (scene.max_shear() > 0.0)  # the shear-magnitude term drives them
     pressed = (scale == 0.0) | ((blocked | (not np.any(scene.fz > 0.0))) & ~sheared)
     bias = pop.current.bias_saii
@@ -213,14 +223,14 @@ def _of_type(afferent_type, types) -> np.ndarray:
 
 def _shear_gained(pop, sel):
     """Whether each afferent's drive has a shear-magnitude term (``CurrentParams.shear_<type>`` > 0)."""
-    gained = [t for t in AFFERENT_TYPES if t != "SAII" and pop.current.stage(t).shear > 0.0]
+    gained = [t for t in AFFERENT_TYPES if t != "SAII" and pop.current.for_type(t).shear > 0.0]
     return _of_type(pop.afferent_type[sel], gained)
 
 
 def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
     n, local = sel.size, scene.sites is not None
     # A multi-site scene's local shear is a weighted sum of the sites' and can cross F_TH where none does.
-    af_stage = scene.max_shear() > (0.0 if local else af_threshold(no_shear)) or not enabled
+    computes_af = scene.max_shear() > (0.0 if local else af_threshold(no_shear)) or not enabled
     af_constant = 0.0 if no_shear == "block" else 1.0
     weights = None
     if local:
@@ -235,13 +245,13 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
     if not enabled:
         return ConditionPlan(scene.name, scene.n_samples, True, af_constant, weights,
                              np.empty(0, np.int64), np.full(n, -1, np.int64))
-    quiet = _quiet(pop, sel, scene, scale, af_stage, af_constant)
+    quiet = _quiet(pop, sel, scene, scale, computes_af, af_constant)
     deterministic = np.flatnonzero(~noisy & ~quiet)
     member = np.where(quiet, -2, -1).astype(np.int64)
     units = np.empty(0, np.int64)
     if deterministic.size:
         stretch = (pop.afferent_type[sel[deterministic]] == "SAII") | _shear_gained(pop, sel[deterministic])
-        tuned = (pop.nap[sel[deterministic]] != UNTUNED) & np.where(stretch, scene.max_shear() > 0.0, af_stage)
+        tuned = (pop.nap[sel[deterministic]] != UNTUNED) & np.where(stretch, scene.max_shear() > 0.0, computes_af)
         keys = _unit_keys(pop, sel[deterministic], tuned, scale[deterministic], local)
         _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
         order = np.argsort(first)  # units in population order, for readable plans
@@ -249,10 +259,11 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
         rank[order] = np.arange(order.size)
         units = deterministic[first[order]]
         member[deterministic] = rank[inverse.ravel()]
-    return ConditionPlan(scene.name, scene.n_samples, af_stage, af_constant, weights, units, member)
+    return ConditionPlan(scene.name, scene.n_samples, computes_af, af_constant, weights, units, member)
 
 
-def make_plan(population, scenes, *, types=None, trials: int = 1, record=RECORD_CHOICES,
+@renamed_keyword("types", "afferent_types")
+def make_plan(population, scenes, *, afferent_types=None, trials: int = 1, record=RECORD_CHOICES,
               no_shear: str = "smooth", chunk_size: int = 4096, time_chunk: int = 2000,
               enabled: bool = True) -> Plan:
     """Decide what to simulate (see the module docstring).
@@ -261,7 +272,7 @@ def make_plan(population, scenes, *, types=None, trials: int = 1, record=RECORD_
     ----------
     population : Population
     scenes : sequence of Scene
-    types : sequence of str, optional
+    afferent_types : sequence of str, optional
         Afferent types to simulate (default: all present).
     trials : int
         Trials per condition.
@@ -278,7 +289,8 @@ def make_plan(population, scenes, *, types=None, trials: int = 1, record=RECORD_
     -------
     Plan
     """
-    requested = tuple(AFFERENT_TYPES) if types is None else tuple(normalize_type(t, "types") for t in types)
+    requested = (tuple(AFFERENT_TYPES) if afferent_types is None
+                 else tuple(normalize_type(t, "afferent_types") for t in afferent_types))
     for r in record:
         check_choice(r, "record", RECORD_CHOICES)
     wanted = _of_type(population.afferent_type, requested)

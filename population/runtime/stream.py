@@ -19,7 +19,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 from ddmm.models.attenuation import NO_SHEAR_READINGS
 from ddmm.models.current_filters import check_fs
 from ddmm.models.engines import METHODS, get_engine, substeps_for
@@ -30,6 +29,8 @@ from ddmm.population.simulation import _grouped, block_pipeline
 from ddmm.population.stimuli.conditioning import Conditioner, Conditioning, noise_allowance
 from ddmm.population.stimuli.recordings import RECORDED
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Contact, Sites
+from ddmm.utils.deprecation import renamed_keyword
+from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 
 __all__ = ["StreamSpikes", "Encoder"]
 
@@ -79,7 +80,7 @@ class Encoder:
         The force sites of a sensor array or multi-digit hand: chunks are
         then (n, n_sites, 3), and each afferent feels its own local force
         (`ddmm.population.anatomy.receptive_fields`), as `simulate` does for `Scene.from_sites`.
-    types : sequence of str, optional
+    afferent_types : sequence of str, optional
         Afferent types to simulate (as `simulate`'s ``types``); the others
         never spike.  A sensor too slow for FA-II leaves them out this way.
     conditioning : Conditioning or None
@@ -110,9 +111,10 @@ class Encoder:
     True
     """
 
+    @renamed_keyword("types", "afferent_types")
     def __init__(self, population, fs: float, *, dt: float = 1e-4, engine: str = "direct", method: str = "euler",
                  seed=None, no_shear: str = "smooth", contact: Contact | None = None, sites: Sites | None = None,
-                 types=None, conditioning: Conditioning | None = RECORDED, model_fs: float | None = None):
+                 afferent_types=None, conditioning: Conditioning | None = RECORDED, model_fs: float | None = None):
         if not isinstance(population, Population):
             raise TypeError(f"population must be a Population, got {type(population).__name__}")
         self.fs = check_positive(fs, "fs", "Hz")
@@ -130,7 +132,7 @@ class Encoder:
                             f"{type(sites).__name__} with contact={contact!r}")
         self.seed, self.contact = root_seed(seed), contact
         self.sites = sites
-        idx = _type_positions(population, types)
+        idx = _type_positions(population, afferent_types)
         check_fs(self.model_fs, population.current, tuple(np.unique(population.afferent_type[idx])))
         self._order = idx[_grouped(population, idx, np.arange(idx.size))]  # contiguous (type, NAP) groups, as offline
         self.population = population
@@ -264,14 +266,14 @@ class Encoder:
         return StreamSpikes(afferent, step * self.dt, forces)
 
 
-def _type_positions(population, types) -> np.ndarray:
-    """Positions of the afferents of ``types`` (all when None), checked as `simulate` checks them."""
-    if types is None:
+def _type_positions(population, afferent_types) -> np.ndarray:
+    """Positions of the afferents of ``afferent_types`` (all when None), checked as `simulate` checks them."""
+    if afferent_types is None:
         return np.arange(len(population))
     from ddmm.models.afferent_types import normalize_type
 
-    codes = {normalize_type(t) for t in ([types] if isinstance(types, str) else types)}
+    codes = {normalize_type(t) for t in ([afferent_types] if isinstance(afferent_types, str) else afferent_types)}
     idx = np.flatnonzero(np.isin(population.afferent_type, sorted(codes)))
     if idx.size == 0:
-        raise ValueError(f"types={sorted(codes)} selects no afferent of this population")
+        raise ValueError(f"afferent_types={sorted(codes)} selects no afferent of this population")
     return idx

@@ -51,8 +51,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.utils.validation import as_finite_array, check_positive
 from ddmm.population.stimuli._conditioning_kernels import gate_hold_contact, hold_band, hold_counts, sos_filter
+from ddmm.utils.validation import as_finite_array, check_positive
 
 __all__ = ["Conditioning", "Conditioner", "condition_forces", "noise_allowance", "CONDITIONING_MODES"]
 

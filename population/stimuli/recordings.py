@@ -19,10 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.utils.resources import check_memory
-from ddmm.utils.validation import check_positive, parse_number, shown
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.scenes import DEFAULT_FS, MAX_FS, Contact, Scene
+from ddmm.utils.resources import check_memory
+from ddmm.utils.validation import check_positive, parse_number, shown
 
 __all__ = ["from_csv", "warn_band", "UNITS", "RECORDED", "RecordingBandWarning", "NEGATIVE_FZ", "GAPS",
            "FA_II_MIN_FS"]
@@ -232,7 +232,8 @@ def warn_band(what: str, fs_in: float, stacklevel: int = 4) -> None:
     if fs_in < FA_II_MIN_FS:
         warnings.warn(RecordingBandWarning(
             f"{what} is sampled at {fs_in:g} Hz and carries 0-{fs_in / 2:g} Hz: FA-II's band (up to 300 Hz) is "
-            "missing, so FA-II respond only to its ramps (leave them out with types=...)"), stacklevel=stacklevel)
+            "missing, so FA-II respond only to its ramps (leave them out with afferent_types=... or --types)"),
+        stacklevel=stacklevel)
 
 
 def _check_options(fs, units, fz_sign, negative_fz, gaps, conditioning) -> None:

@@ -54,8 +54,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.utils.validation import check_positive, shown
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Scene, Sites, Stage, taxel_radius
+from ddmm.utils.validation import check_positive, shown
 
 __all__ = ["contact_grid", "torsion", "incipient_slip", "grasp", "digit_tip_sites"]
 

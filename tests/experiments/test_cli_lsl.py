@@ -75,7 +75,7 @@ def test_stream_over_lsl_equals_the_in_process_encoder():
     meta = read_spike_metadata(info)
     offset = float(meta["input"]["clock_offset_s"])
     pop = sample_population("fingertip", rng=3)
-    expected = Encoder(pop, 500.0, seed=3, types=("SAI", "RAI", "SAII")).push(raw * 1e-3)
+    expected = Encoder(pop, 500.0, seed=3, afferent_types=("SAI", "RAI", "SAII")).push(raw * 1e-3)
     got = np.concatenate(ids)
     np.testing.assert_array_equal(got, pop.afferent_id[expected.afferent])
     steps = np.round((np.concatenate(stamps) - t0 - offset) / 1e-4).astype(np.int64)
@@ -190,7 +190,7 @@ def test_stream_publishes_stimulation_pulses_equal_to_the_in_process_encoder(tmp
         proc.kill()
     assert proc.returncode == 0, err
     pop = sample_population("fingertip", rng=5)
-    expected = StimulationEncoder(Encoder(pop, 1000.0, seed=5, types=("SAI", "RAI")),
+    expected = StimulationEncoder(Encoder(pop, 1000.0, seed=5, afferent_types=("SAI", "RAI")),
                                   read_electrodes(table)).push(raw)
     got = np.concatenate(rows)
     assert f"{expected.time.size:,} pulses out" in err and expected.time.size > 20

@@ -84,12 +84,12 @@ def test_forces_legend_never_covers_a_trace():
 
 
 def test_an_unexpected_error_is_one_line_and_debug_shows_it(capsys, monkeypatch):
-    from ddmm.experiments import cmd_population
+    from ddmm.experiments.cli import plan as plan_command
 
     def broken(args):
         raise KeyError("afferent")
 
-    monkeypatch.setattr(cmd_population, "run_plan", broken)
+    monkeypatch.setattr(plan_command, "run_plan", broken)
     monkeypatch.delenv("DDMM_DEBUG", raising=False)
     code = main(["plan", "--scene", "birznieks"])
     err = capsys.readouterr().err

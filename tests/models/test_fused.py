@@ -51,8 +51,8 @@ def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite=N
                                                                   no_shear=no_shear))[:, 0]
         if kind != "SAII":  # the presets' shear-magnitude term (a no-op at the paper's defaults)
             raw = profile_factor(fx, fy, theta[j], nap, k[j])
-            drive[:, [j]] = shear_drive(drive[:, [j]], fx, fy, raw, params.stage(kind).shear,
-                                        params.stage(kind).opponent_shear)
+            drive[:, [j]] = shear_drive(drive[:, [j]], fx, fy, raw, params.for_type(kind).shear,
+                                        params.for_type(kind).opponent_shear)
     current = np.empty_like(drive)
     for kind in dict.fromkeys(TYPES):
         cols = np.flatnonzero(np.array(TYPES) == kind)

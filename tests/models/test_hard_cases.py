@@ -129,8 +129,8 @@ def test_brian2_does_not_take_over_python_warnings():
 
 
 def test_brian2_log_warnings_become_python_warnings():
-    from ddmm.models.engines.brian2.engine import Brian2Warning, _import_brian2
-    _import_brian2()
+    from ddmm.models.engines.brian2.engine import Brian2Warning, import_brian2
+    import_brian2()
     import logging
     with pytest.warns(Brian2Warning, match="test message"):
         logging.getLogger("brian2.devices").warning("test message")

@@ -153,10 +153,10 @@ def test_fused_transducer_equals_the_stage_transducer(seed, kind, excited, live,
     # `transduce_columns` (the fused pipeline's) against `transduce_inplace` (the stages'), bit for bit, on
     # columns lo..lo+width of a drive whose rows are zero or not in any pattern (it skips all-zero rows).
     from ddmm.models._stage_kernels import transduce_columns, transduce_inplace
-    from ddmm.models.currents import stage_constants
+    from ddmm.models.currents import type_filter_constants
 
     rng = np.random.default_rng(seed)
-    stage = stage_constants(PHYSIO, kind, FS)[0]
+    stage = type_filter_constants(PHYSIO, kind, FS)[0]
     drive = np.abs(rng.normal(0.0, 50.0, (len(live), 10))) * np.asarray(live)[:, None]  # unsigned drive: >= 0
     drive[rng.random(drive.shape) < 0.1] = -0.0
     excite = rng.uniform(0.5, 1.5, width) if excited else None
@@ -169,7 +169,7 @@ def test_fused_transducer_equals_the_stage_transducer(seed, kind, excited, live,
 
 def test_fused_transducer_refuses_a_signed_stage():
     from ddmm.models._stage_kernels import transduce_columns
-    from ddmm.models.currents import stage_constants
+    from ddmm.models.currents import type_filter_constants
 
     with pytest.raises(ValueError, match="unsigned"):
-        transduce_columns(np.zeros((3, 2)), slice(0, 2), stage_constants(PHYSIO, "SAII", FS)[0])
+        transduce_columns(np.zeros((3, 2)), slice(0, 2), type_filter_constants(PHYSIO, "SAII", FS)[0])

@@ -90,7 +90,7 @@ def test_failed_write_leaves_no_file(small, tmp_path, monkeypatch):
     dict(trials=2, seed=3),                                       # noisy population
     dict(trials=3, seed=3, noiseless=True),                       # collapse afferents and trials
     dict(trials=1, seed=3, noiseless=True, no_shear="block"),     # AF = 0 without shear: quiet
-    dict(trials=2, seed=3, types=("RAI", "RAII")),                # types not requested
+    dict(trials=2, seed=3, afferent_types=("RAI", "RAII")),              # types not requested
 ])
 def test_planned_equals_unplanned(small, kwargs):
     kwargs = dict(kwargs)
@@ -109,9 +109,9 @@ def test_plan_skips_what_a_scene_does_not_need(fingertip):
                                 x_mm=[0.0, 0.0, 50.0, 0.0])
     plan = plan_run(quiet_pop, [birznieks(None), birznieks(90.0, contact=Contact(0, 0, 1))], trials=4)
     normal, touch = plan.conditions
-    assert not normal.af_stage and normal.weights is None
+    assert not normal.computes_af and normal.weights is None
     assert normal.units.size == 3 and normal.noisy.size == 0  # two identical SAI collapse
-    assert touch.af_stage and touch.n_quiet == 1               # the far RAI has zero weight
+    assert touch.computes_af and touch.n_quiet == 1               # the far RAI has zero weight
     text = plan.describe(quiet_pop, [birznieks(None), birznieks(90.0, contact=Contact(0, 0, 1))])
     assert "skipped (no shear" in text and "noise: off" in text and "once for all 4 trials" in text
 
@@ -164,7 +164,7 @@ def test_spatial_weighting_silences_far_afferents():
 @pytest.mark.parametrize("kwargs,exc,match", [
     (dict(dt=0.0), ValueError, "dt"), (dict(dt=3e-4), ValueError, "dt"), (dict(engine="nest"), ValueError, "engine"),
     (dict(trials=0), ValueError, "trials"), (dict(no_shear="x"), ValueError, "no_shear"),
-    (dict(types=("SAIII",)), ValueError, "types"), (dict(record=("voltage",)), ValueError, "record"),
+    (dict(afferent_types=("SAIII",)), ValueError, "afferent_types"), (dict(record=("voltage",)), ValueError, "record"),
     (dict(seed=-1), TypeError, "seed"), (dict(chunk_size=0), ValueError, "chunk_size"),
 ])
 def test_bad_arguments(small, kwargs, exc, match):

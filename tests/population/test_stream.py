@@ -128,7 +128,7 @@ def test_the_spike_cap_warning_survives_the_fused_path():
 @given(cuts=st.lists(st.integers(1, 299), max_size=12, unique=True))
 def test_a_100_hz_sensor_streams_and_equals_the_offline_file_in_the_causal_mode(tmp_path_factory, cuts):
     """Raw 100 Hz samples with sensor noise: the encoder's causal conditioning and types equal `from_csv`
-    (same conditioning) and `simulate(types=...)`, bit for bit, for any chunking."""
+    (same conditioning) and `simulate(afferent_types=...)`, bit for bit, for any chunking."""
     from ddmm.population import from_csv
     from ddmm.population.stimuli.conditioning import Conditioning
 
@@ -142,8 +142,8 @@ def test_a_100_hz_sensor_streams_and_equals_the_offline_file_in_the_causal_mode(
     types = ("SAI", "RAI", "SAII")
     with pytest.warns(UserWarning, match="FA-II's band"):
         scene = from_csv(path)
-    offline = simulate(pop, scene, engine="direct", seed=3, types=types, quiet=True)
-    enc = Encoder(pop, 100.0, seed=3, types=types, conditioning=Conditioning(), model_fs=1000.0)
+    offline = simulate(pop, scene, engine="direct", seed=3, afferent_types=types, quiet=True)
+    enc = Encoder(pop, 100.0, seed=3, afferent_types=types, conditioning=Conditioning(), model_fs=1000.0)
     edges = [0] + sorted(cuts) + [300]
     aff, times = concat([enc.push(f[a:b]) for a, b in zip(edges[:-1], edges[1:])])
     ids = offline.afferent.values[offline.spike_afferent.values]

@@ -40,6 +40,7 @@ Design (measured on this machine kind, see docs/user-guide.md, "Engines"):
 
 from __future__ import annotations
 
+import dataclasses
 import gc
 import hashlib
 import logging
@@ -52,15 +53,14 @@ import tempfile
 import threading
 import warnings
 from contextlib import contextmanager
-import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ddmm.utils.cache import cache_root, private_dir
 from ddmm.models.engines.brian2.lanes import lane, write_table
 from ddmm.models.neuron import V_FLOOR, refractory_steps
+from ddmm.utils.cache import cache_root, private_dir
 
 __all__ = ["run_brian2", "cache_dir", "import_brian2", "Brian2Warning"]
 

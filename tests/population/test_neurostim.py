@@ -122,7 +122,7 @@ def test_every_limit_holds_for_random_tables_spikes_and_forces(table, rule, seed
     samples = np.sort(rng.integers(0, n, rng.integers(0, 4000)))
     members = [np.flatnonzero(rng.uniform(size=n_aff) < 0.6) for _ in table]
     kernel = PulseKernel(table, Biomimetic(rate_sat_hz=rng.uniform(1, 50)) if rule == "biomimetic" else
-                         __import__("ddmm").population.stimulation.get_rule(rule), fs, members, np.ones(n_aff))
+                         __import__("ddmm").population.neurostim.get_rule(rule), fs, members, np.ones(n_aff))
     (t, e, a), traces = kernel.advance(force, samples, rng.integers(0, n_aff, samples.size))
     assert _violations(table, fs, force, t, e, a) == []
     assert np.all(traces[0] <= table.column("max_rate_hz")) and np.all(traces[0] >= 0)  # the commands, too
