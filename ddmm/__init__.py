@@ -1,13 +1,17 @@
 """ddmm: a population-coding simulator of tactile afferent arrays (the DDMM).
 
-Three subpackages, layered one way (models <- population <- experiments):
+Three subpackages, layered one way (models <- population <- experiments),
+on the helpers they share (`ddmm.utils`):
 
 - `ddmm.models`: single-afferent physics (NAP geometry, attenuation,
   currents, Izhikevich neurons) and the engines that integrate them;
 - `ddmm.population`: specs, anatomy, stimuli, simulation into an xarray
   Dataset, analysis and file I/O;
 - `ddmm.experiments`: the ``ddmm`` command line, reproductions of the
-  paper, calibration, benchmarks and figures.
+  paper, calibration, validation, benchmarks and figures.
+
+The map of every module, and where each kind of change goes, is
+``docs/development.md``.
 
 The everyday names are importable from here (on first use, so ``import
 ddmm`` stays cheap):

@@ -35,7 +35,7 @@ import math
 
 import numpy as np
 
-from ddmm.experiments.paper.cells import _paper, type_cells
+from ddmm.experiments.paper.cells import paper_value, type_cells
 from ddmm.experiments.paper.reproduce import ReproConfig
 from ddmm.models.afferent_types import PAPER_TYPES
 from ddmm.models.current_params import CurrentParams
@@ -88,7 +88,7 @@ def type_config(kind: str, u, reading: str, definition: str, base: ReproConfig =
 def objective(kind: str, config: ReproConfig, cells=FIT_CELLS) -> tuple:
     """(max + mean / 10 of the relative errors over ``cells``, the model's cells)."""
     values, _ = type_cells(kind, config)
-    errors = [abs(values[key] - _paper(kind, key)) / abs(_paper(kind, key)) for key in cells]
+    errors = [abs(values[key] - paper_value(kind, key)) / abs(paper_value(kind, key)) for key in cells]
     return max(errors) + 0.1 * float(np.mean(errors)), values
 
 

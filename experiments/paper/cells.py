@@ -26,7 +26,7 @@ from ddmm.models.engines import SpikeCapWarning
 from ddmm.models.metrics import direction_index
 from ddmm.population.data.published import PAPER_TABLE2, PAPER_TABLE3
 
-__all__ = ["TABLES", "cell_keys", "type_cells", "reproduce_cells", "fig8_peaks", "with_engine"]
+__all__ = ["TABLES", "cell_keys", "paper_value", "type_cells", "reproduce_cells", "fig8_peaks", "with_engine"]
 
 TABLES = ("table2", "table3", "fig8")
 _PRSI_ANGLES = (0.0, 90.0, 180.0, 270.0)
@@ -41,7 +41,8 @@ def cell_keys(table: str | None = None) -> list:
     return keys if table is None else [k for k in keys if k[0] == table]
 
 
-def _paper(kind: str, key) -> float:
+def paper_value(kind: str, key) -> float:
+    """The paper's value of one cell ``(table, profile, row)`` for type ``kind`` (Table II PRSI or Table III SF)."""
     table, profile, row = key
     if table == "II":
         return PAPER_TABLE2[profile][kind]
@@ -130,7 +131,7 @@ def reproduce_cells(calibration: dict, fitted=None, tables=TABLES) -> dict:
         for key in cell_keys():
             if {"II": "table2", "III": "table3"}[key[0]] not in tables:
                 continue
-            paper = float(_paper(kind, key))
+            paper = float(paper_value(kind, key))
             cells.append({"table": key[0], "type": kind, "profile": key[1], "row": key[2], "paper": paper,
                           "model": round(values[key], 4), "rel_error": _rel_error(values[key], paper),
                           "role": _role(key, set(fitted.get(kind, ())))})

@@ -97,3 +97,40 @@ def test_a_build_killed_midway_leaves_nothing_where_the_cache_looks(tmp_path, mo
     first = integrate(_current(), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")
     direct = integrate(_current(), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="direct")
     np.testing.assert_array_equal(first.step, direct.step)
+
+
+def test_an_installed_binary_is_never_rewritten_in_place(monkeypatch, tmp_path):
+    """A process whose generated project differs relinks a copy and installs it whole, with its digest: another
+    process may be running the installed binary, and a binary changed in place no longer matches its digest."""
+    monkeypatch.setenv("DDMM_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(engine, "_BUILDS", {})
+    first = integrate(_current(), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")
+    (build,) = [p for p in (tmp_path / "cache" / "brian2").iterdir() if p.is_dir() and p.name.startswith("n")]
+    before = (build / "main").stat().st_ino
+    generate = engine._generate
+
+    def relinking(key, directory, shown=None):  # as make does when this process's project differs
+        made = generate(key, directory, shown)
+        with open(directory / "main", "ab") as f:
+            f.write(b"\0")
+        return made
+
+    monkeypatch.setattr(engine, "_generate", relinking)
+    monkeypatch.setattr(engine, "_BUILDS", {})
+    again = integrate(_current(), fs=1000.0, dt=1e-4, afferent_type="SAI", engine="brian2")
+    np.testing.assert_array_equal(first.step, again.step)
+    assert engine._verified(build) and (build / "main").stat().st_ino != before
+
+
+def test_fresh_processes_generate_the_same_project(tmp_path):
+    """Brian2 sets the clocks' start values in a set's order; the engine's device sorts them, so a cached
+    build stays as it is from process to process (it was relinked in every other process)."""
+    env = dict(os.environ, DDMM_CACHE_DIR=str(tmp_path / "cache"))
+    sources = []
+    for _ in range(4):
+        out = subprocess.run([sys.executable, "-c", _RUN], env=env, capture_output=True, text=True, timeout=600)
+        assert out.returncode == 0, out.stderr[-2000:]
+        (build,) = [p for p in (tmp_path / "cache" / "brian2").iterdir() if p.is_dir() and p.name.startswith("n")]
+        sources.append((build / "main.cpp").read_text())
+        assert "does not match its recorded digest" not in out.stderr
+    assert all(s == sources[0] for s in sources)

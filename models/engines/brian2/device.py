@@ -26,7 +26,8 @@ from types import SimpleNamespace
 from brian2.devices.cpp_standalone.codeobject import CPPStandaloneCodeObject
 from brian2.devices.cpp_standalone.device import CPPStandaloneDevice
 
-__all__ = ["EngineCodeObject", "EngineDevice", "TABLE_ENV", "drop_per_step_clock", "input_function"]
+__all__ = ["EngineCodeObject", "EngineDevice", "TABLE_ENV", "drop_per_step_clock", "input_function",
+           "sort_clock_settings"]
 
 _PER_STEP = """        current = std::clock();
         elapsed_realtime = (double)(current - start)/(1 * CLOCKS_PER_SEC);
@@ -55,11 +56,47 @@ def drop_per_step_clock(source: str) -> str:
     return source.replace(_PER_STEP, "").replace(_AFTER_LOOP, _AFTER_LOOP + _ONCE)
 
 
+def sort_clock_settings(queue: list, start: int = 0) -> None:
+    """Put each run of consecutive clock start-value settings in ``queue[start:]`` in array-name order, in place.
+
+    `CPPStandaloneDevice.network_run` sets each clock's ``timestep`` and ``t``
+    while iterating over a set of clocks, whose order follows their memory
+    addresses: two processes generated ``main.cpp`` with the lines swapped, so
+    ``make`` relinked a cached binary that was already right.  The settings
+    are independent assignments, so their order does not change the program.
+
+    Examples
+    --------
+    >>> q = [("x", ()), ("set_by_single_value", ("_array_b_clock_t", 0, "0.0")),
+    ...      ("set_by_single_value", ("_array_a_clock_t", 0, "0.0")), ("y", ())]
+    >>> sort_clock_settings(q)
+    >>> [entry[1][0] for entry in q[1:3]]
+    ['_array_a_clock_t', '_array_b_clock_t']
+    """
+    def is_clock(entry) -> bool:
+        return entry[0] == "set_by_single_value" and str(entry[1][0]).endswith(("clock_timestep", "clock_t"))
+
+    i = start
+    while i < len(queue):
+        j = i
+        while j < len(queue) and is_clock(queue[j]):
+            j += 1
+        if j - i > 1:
+            queue[i:j] = sorted(queue[i:j], key=lambda entry: str(entry[1][0]))
+        i = max(j, i + 1)
+
+
 class EngineDevice(CPPStandaloneDevice):
     """`CPPStandaloneDevice` generating with `EngineCodeObject` and a clock-free network loop."""
 
     def code_object_class(self, codeobj_class=None, fallback_pref=None):
         return EngineCodeObject if codeobj_class is None else codeobj_class
+
+    def network_run(self, net, *args, **kwargs):
+        """Brian2's, with the clocks' start values set in name order (Brian2 sets them in a set's order)."""
+        start = len(self.main_queue)
+        super().network_run(net, *args, **kwargs)
+        sort_clock_settings(self.main_queue, start)
 
     def generate_network_source(self, writer, compiler):
         limit = self._maximum_run_time

@@ -275,11 +275,37 @@ def _build(key: tuple) -> _Build:
         for stale in directory.parent.glob(f".{directory.name}.build-*"):  # a killed build's leftovers
             shutil.rmtree(stale, ignore_errors=True)
         if _verified(directory):
-            return _generate(key, directory)  # installed and intact: make finds nothing to do
+            return _regenerate(key, directory)
         if (directory / "main").exists():
             print(f"ddmm: the cached Brian2 binary {directory / 'main'} does not match its recorded digest "
                   "(damaged or replaced): rebuilding it", file=sys.stderr, flush=True)
         return _install(key, directory)
+
+
+def _regenerate(key: tuple, directory: Path) -> _Build:
+    """This process's project for an installed, intact build, generated into a copy of it.
+
+    Usually ``make`` finds nothing to do and the copy is dropped.  When this
+    process's project differs (Brian2 named an object apart because another
+    of that name is alive here), ``make`` relinks ``main``: the copy is then
+    installed by an atomic rename with its digest, so an installed binary is
+    never rewritten in place (another process may be running it, and its
+    recorded digest would no longer match).
+    """
+    tmp = Path(tempfile.mkdtemp(prefix=f".{directory.name}.build-", dir=directory.parent))
+    try:
+        shutil.copytree(directory, tmp / "project", symlinks=True)  # copy2 keeps the times make compares
+        build = _generate(key, tmp / "project", shown=directory)
+        if _digest(tmp / "project" / "main") == _digest(directory / "main"):
+            return dataclasses.replace(build, directory=directory)
+        _record_digest(tmp / "project")
+        aside = Path(tempfile.mkdtemp(prefix=f".{directory.name}.build-", dir=directory.parent))
+        os.replace(directory, aside / "old")
+        os.replace(tmp / "project", directory)
+        shutil.rmtree(aside, ignore_errors=True)
+        return dataclasses.replace(build, directory=directory)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 def _install(key: tuple, directory: Path) -> _Build:
