@@ -1,4 +1,8 @@
-"""Shared test settings: hypothesis profiles and an isolated Brian2 build cache."""
+"""Shared test settings: hypothesis profiles and a loopback-only Lab Streaming Layer configuration.
+
+The Brian2 build cache is the user's own (``DDMM_CACHE_DIR`` or ``~/.cache/ddmm``), as a user's runs would
+share it; tests that damage or race builds use a cache of their own.
+"""
 
 import os
 import tempfile
