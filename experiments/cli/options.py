@@ -21,6 +21,9 @@ from ddmm.population.io.arrays import EXTENSIONS
 __all__ = ["SCENES", "add_engine_option", "add_run_options", "check_out_file", "parse_contact", "parse_directions",
            "parse_types", "population_from_args", "scenes_from_args"]
 
+#: The synthetic scenes ``--scene`` names (besides a recording or a sensor-array file).
+SCENES = ("birznieks", "press-push-lift", "rotating-shear")
+
 
 def add_engine_option(p, default: str) -> None:
     """``--engine``, its choices the registered engines, its help each engine's summary."""
@@ -29,9 +32,6 @@ def add_engine_option(p, default: str) -> None:
     summaries = "; ".join(f"{name}: {get_engine(name).summary}" for name in engine_names())
     p.add_argument("--engine", choices=engine_names(), default=default,
                    help=f"the engine that integrates the neurons (default {default}). {summaries}")
-
-
-SCENES = ("birznieks", "press-push-lift", "rotating-shear")
 
 
 def add_run_options(p, *, out_required: bool) -> None:

@@ -11,22 +11,7 @@ from ddmm.population.data.published import HUMAN_DSI, HUMAN_TUNED_FRACTION
 
 __all__ = ["TUNING_REFERENCE", "register", "run_tuning", "run_tuning_stats"]
 
-
-def register(sub) -> None:
-    """Add ``ddmm tuning``."""
-    p = sub.add_parser("tuning", help="direction-tuning statistics against human recordings (~86%% tuned)")
-    p.add_argument("--population", default="fingertip")
-    p.add_argument("--seed", type=seed_arg, default=0)
-    p.add_argument("--trials", type=int, default=TUNING_TRIALS, help=f"per condition (default {TUNING_TRIALS})")
-    add_engine_option(p, "direct")
-    p.add_argument("--correction", choices=("none", "bonferroni"), default="none")
-    p.add_argument("--out", metavar="DIR")
-    p.add_argument("--json", action="store_true")
-    p.set_defaults(func=run_tuning)
-
-
 TUNING_TRIALS = 5  # ddmm.population.analysis.tuning.DEFAULT_TRIALS, repeated so that registering the parser imports nothing heavy
-
 
 TUNING_REFERENCE = {
     "tuned_fraction": {"recorded": HUMAN_TUNED_FRACTION["all"], "SAI": HUMAN_TUNED_FRACTION["SAI"],
@@ -39,6 +24,19 @@ TUNING_REFERENCE = {
     "roles": {"SAI": "fitted", "RAI": "fitted", "SAII": "prediction", "RAII": "prediction",
               "recorded": "count-weighted mix of the fitted SA-I and FA-I fractions and the SA-II prediction"},
 }
+
+
+def register(sub) -> None:
+    """Add ``ddmm tuning``."""
+    p = sub.add_parser("tuning", help="direction-tuning statistics against human recordings (~86%% tuned)")
+    p.add_argument("--population", default="fingertip")
+    p.add_argument("--seed", type=seed_arg, default=0)
+    p.add_argument("--trials", type=int, default=TUNING_TRIALS, help=f"per condition (default {TUNING_TRIALS})")
+    add_engine_option(p, "direct")
+    p.add_argument("--correction", choices=("none", "bonferroni"), default="none")
+    p.add_argument("--out", metavar="DIR")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=run_tuning)
 
 
 def run_tuning_stats(population="fingertip", seed=0, trials=TUNING_TRIALS, engine="direct", correction="none"):
