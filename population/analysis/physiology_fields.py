@@ -47,12 +47,12 @@ def probe_scene(force_n: float) -> Scene:
                  (Stage("loading", 0.1, 0.15), Stage("hold", 0.15, 0.8)), Contact(0.0, 0.0, 0.5))
 
 
-def field_radii(population, kind: str, context) -> np.ndarray:
-    """Radius (mm) of the responding field of ``kind`` at each of `FIELD_FORCES_N` (0 where none responds)."""
+def field_radii(population, afferent_type: str, context) -> np.ndarray:
+    """Radius (mm) of the responding field of ``afferent_type`` at each of `FIELD_FORCES_N` (0 where none responds)."""
     from ddmm.population.sampling import make_population
 
     quiet = replace(population.current, **{f"excite_cv_{t.lower()}": 0.0 for t in ("SAI", "RAI", "RAII", "SAII")})
-    line = make_population([kind] * _DISTANCES_MM.size, x_mm=_DISTANCES_MM, current=quiet,
+    line = make_population([afferent_type] * _DISTANCES_MM.size, x_mm=_DISTANCES_MM, current=quiet,
                            name=f"{population.name}_probe_line", receptive_field=population.receptive_field)
     ds = _run(line, [probe_scene(f) for f in FIELD_FORCES_N], context, record=("spikes",))
     radii = np.zeros(len(FIELD_FORCES_N))
