@@ -5,7 +5,9 @@
 - `decoding`: shear direction decoded from population spikes (``ddmm decode``);
 - `array_tasks`: torque and slip decoded from multi-site scenes (``ddmm decode --task torque|slip``);
 - `recordings`: noisy recordings at 100 Hz-5 kHz through the conditioning stage
-  (``python -m ddmm.experiments.validation.recordings``).
+  (``python -m ddmm.experiments.validation.recordings``);
+- `everyday`: presses and releases at 0.5-40 N/s and each unit's vibration threshold, on unseen
+  seeds (``python -m ddmm.experiments.validation.everyday``).
 """
 
 from ddmm.utils.lazy import lazy_exports
@@ -15,5 +17,6 @@ _WHERE = {
     "decoding": ("run_decoding", "summarise"),
     "array_tasks": ("run_slip", "run_torque"),
     "recordings": ("run_check",),
+    "everyday": ("run_everyday",),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)
