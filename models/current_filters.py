@@ -23,6 +23,7 @@ from ddmm.models.afferent_types import AFFERENT_TYPES
 from ddmm.models.current_params import CurrentParams, TypeCurrentParams
 from ddmm.utils.cache import cache_root
 from ddmm.utils.deprecation import renamed_keyword
+from ddmm.utils.deprecation import warn_renamed
 from ddmm.utils.validation import as_finite_array, check_positive
 
 __all__ = ["RAII_FS_FACTOR", "FilterState", "check_fs", "filter_force", "initial_filter_state", "lowpass_sos",
@@ -225,8 +226,5 @@ def type_filter_constants(params: CurrentParams, afferent_type: str, fs: float):
 
 def stage_constants(params: CurrentParams, afferent_type: str, fs: float):
     """Deprecated name of `type_filter_constants` ("stage" names a scene's interval)."""
-    import warnings
-
-    warnings.warn("stage_constants() is deprecated and will be removed in the next release; use "
-                  "type_filter_constants()", DeprecationWarning, stacklevel=2)
+    warn_renamed("stage_constants()", "type_filter_constants()")
     return type_filter_constants(params, afferent_type, fs)

@@ -10,13 +10,13 @@ parametrise, and which of them depart from the paper, is described in
 
 from __future__ import annotations
 
-import warnings
 
 from dataclasses import dataclass
 
 import numpy as np
 
 from ddmm.models.afferent_types import normalize_type
+from ddmm.utils.deprecation import warn_renamed
 from ddmm.utils.validation import check_positive, shown
 
 __all__ = ["DERIVATIVE_ORDER", "CurrentParams", "TypeCurrentParams"]
@@ -289,8 +289,7 @@ class CurrentParams:
 
     def stage(self, afferent_type: str) -> TypeCurrentParams:
         """Deprecated name of `for_type` ("stage" names a scene's interval, `ddmm.population.Stage`)."""
-        warnings.warn("CurrentParams.stage() is deprecated and will be removed in the next release; use "
-                      "CurrentParams.for_type()", DeprecationWarning, stacklevel=2)
+        warn_renamed("CurrentParams.stage()", "CurrentParams.for_type()")
         return self.for_type(afferent_type)
 
 
@@ -366,7 +365,6 @@ class TypeCurrentParams:
 
 def __getattr__(name):
     if name == "CurrentStage":  # the old name, for one release
-        warnings.warn("CurrentStage is deprecated and will be removed in the next release; use TypeCurrentParams",
-                      DeprecationWarning, stacklevel=2)
+        warn_renamed("CurrentStage", "TypeCurrentParams")
         return TypeCurrentParams
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

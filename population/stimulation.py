@@ -6,13 +6,12 @@ with a `DeprecationWarning`; they are the very `neurostim` modules.
 """
 
 import sys
-import warnings
 from importlib import import_module
 
 from ddmm.population import neurostim as _neurostim
+from ddmm.utils.deprecation import warn_renamed
 
-warnings.warn("ddmm.population.stimulation is deprecated and will be removed in the next release: use "
-              "ddmm.population.neurostim (the same modules)", DeprecationWarning, stacklevel=2)
+warn_renamed("ddmm.population.stimulation", "ddmm.population.neurostim (the same modules)", stacklevel=2)
 
 for _name in ("electrodes", "rules", "pulses", "encode", "stream"):
     sys.modules[f"{__name__}.{_name}"] = import_module(f"ddmm.population.neurostim.{_name}")

@@ -6,7 +6,7 @@ import pkgutil
 
 import pytest
 
-PACKAGES = ("ddmm.models", "ddmm.population", "ddmm.experiments")
+PACKAGES = ("ddmm.utils", "ddmm.models", "ddmm.population", "ddmm.experiments")
 
 
 def _modules():

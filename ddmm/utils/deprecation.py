@@ -5,7 +5,25 @@ from __future__ import annotations
 import functools
 import warnings
 
-__all__ = ["renamed_keyword"]
+__all__ = ["renamed_keyword", "warn_renamed"]
+
+
+def warn_renamed(old: str, new: str, stacklevel: int = 3) -> None:
+    """Warn that ``old`` (a name as its user wrote it) is now ``new``, with one message for every rename.
+
+    ``stacklevel`` 3 points at the caller of the function that warns.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     warn_renamed("f(types=)", "afferent_types=")
+    >>> str(caught[0].message)
+    'f(types=) is deprecated and will be removed in the next release; use afferent_types='
+    """
+    warnings.warn(f"{old} is deprecated and will be removed in the next release; use {new}", DeprecationWarning,
+                  stacklevel=stacklevel)
 
 
 def renamed_keyword(old: str, new: str):
@@ -30,8 +48,7 @@ def renamed_keyword(old: str, new: str):
             if old in kwargs:
                 if new in kwargs:
                     raise TypeError(f"{func.__qualname__}() got {old}= (deprecated) and {new}=: give {new}= only")
-                warnings.warn(f"{func.__qualname__}(): the keyword {old}= is deprecated and will be removed in the "
-                              f"next release; use {new}=", DeprecationWarning, stacklevel=2)
+                warn_renamed(f"{func.__qualname__}({old}=)", f"{new}=")
                 kwargs[new] = kwargs.pop(old)
             return func(*args, **kwargs)
         return wrapper

@@ -36,6 +36,7 @@ from ddmm.models.attenuation import F_TH, UNTUNED
 from ddmm.models.variability import bias_multiplier
 from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
 from ddmm.utils.deprecation import renamed_keyword
+from ddmm.utils.deprecation import warn_renamed
 from ddmm.utils.validation import check_choice
 
 __all__ = ["RECORD_CHOICES", "ConditionPlan", "Plan", "af_threshold", "make_plan"]
@@ -79,10 +80,7 @@ class ConditionPlan:
     @property
     def af_stage(self) -> bool:
         """Deprecated name of `computes_af` ("stage" names a scene's interval)."""
-        import warnings
-
-        warnings.warn("ConditionPlan.af_stage is deprecated and will be removed in the next release; use "
-                      "computes_af", DeprecationWarning, stacklevel=2)
+        warn_renamed("ConditionPlan.af_stage", "computes_af")
         return self.computes_af
 
     @property
