@@ -22,8 +22,7 @@ from ddmm.models._stage_kernels import stage_kernel
 from ddmm.models.afferent_types import AFFERENT_TYPES
 from ddmm.models.current_params import CurrentParams, TypeCurrentParams
 from ddmm.utils.cache import cache_root
-from ddmm.utils.deprecation import renamed_keyword
-from ddmm.utils.deprecation import warn_renamed
+from ddmm.utils.deprecation import renamed_keyword, warn_renamed
 from ddmm.utils.validation import as_finite_array, check_positive
 
 __all__ = ["RAII_FS_FACTOR", "FilterState", "check_fs", "filter_force", "initial_filter_state", "lowpass_sos",

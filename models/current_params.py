@@ -10,7 +10,6 @@ parametrise, and which of them depart from the paper, is described in
 
 from __future__ import annotations
 
-
 from dataclasses import dataclass
 
 import numpy as np

@@ -35,8 +35,7 @@ from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import F_TH, UNTUNED
 from ddmm.models.variability import bias_multiplier
 from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
-from ddmm.utils.deprecation import renamed_keyword
-from ddmm.utils.deprecation import warn_renamed
+from ddmm.utils.deprecation import renamed_keyword, warn_renamed
 from ddmm.utils.validation import check_choice
 
 __all__ = ["RECORD_CHOICES", "ConditionPlan", "Plan", "af_threshold", "make_plan"]
