@@ -17,7 +17,8 @@ from ddmm.models.attenuation import profile_value
 __all__ = ["mix_forces", "mixing_matrix"]
 
 # Rows of the per-afferent float table.
-_COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA, _TONIC = range(13)
+_COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA, _TONIC, _DEAD = range(14)
+_N_AFF_ROWS = 14
 # Rows of the per-group float and integer tables.
 _ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _NEGATIVE, _DYN, _ALPHA_DYN, _FALL, _SHEAR_G, _OPP_SHEAR = range(11)
 _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = range(9)

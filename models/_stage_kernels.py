@@ -37,12 +37,14 @@ def filter_sections(cur, lo, hi, sos, g, n_sections, z):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, threshold, negative, gain, normals,
-               col, cv_scale, noisy, signed):
+def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, thresholded, threshold, negative, gain,
+               normals, col, cv_scale, noisy, signed):
     """The drive d of afferents ``lo..hi`` from their filtered deviations ``x`` (newtons), in place on ``x``.
 
     The derivative of ``order``, adaptation, ``gain`` and receptor noise
-    (``normals[:, col]``, rectified unless ``signed``).  A derivative
+    (``normals[:, col]``, rectified unless ``signed``).  ``threshold`` holds
+    each afferent's dead zone in the drive's units (its type's threshold over
+    its sensitivity), subtracted when ``thresholded``.  A derivative
     (``order`` > 0) is rectified with the weight ``negative`` on its negative
     half-wave (1.0: the absolute value, the paper's eqs 2-3; 0.0: half-wave
     rectification, which keeps the phase of a vibration); ``y1``, ``y2`` and
@@ -55,6 +57,7 @@ def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, t
     fs2 = fs * fs
     # Views from 0: loops over range(lo, hi) vectorise worse.
     x, offset, y1, y2, slow, gain = x[lo:hi], offset[lo:hi], y1[lo:hi], y2[lo:hi], slow[lo:hi], gain[lo:hi]
+    threshold = threshold[lo:hi]
     n = hi - lo
     if order == 0:
         for j in range(n):
@@ -84,11 +87,11 @@ def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, t
     if order > 0 and negative != 1.0:
         for j in range(n):
             x[j] = x[j] if x[j] >= 0.0 else -negative * x[j]  # >= 0 from here: abs below leaves it as it is
-    if order > 0 and (adapt > 0.0 or threshold > 0.0):
+    if order > 0 and (adapt > 0.0 or thresholded):
         for j in range(n):
             a = abs(x[j])
             slow[j] = slow[j] + alpha_adapt * (a - slow[j])
-            x[j] = max((a - adapt * slow[j]) - threshold, 0.0)
+            x[j] = max((a - adapt * slow[j]) - threshold[j], 0.0)
     if signed:
         for j in range(n):
             x[j] = gain[j] * x[j]
@@ -130,12 +133,12 @@ def receptor_noise_keyed(x, lo, hi, key, afferent_id, sample, cv_scale, signed, 
 
 
 @nb.njit(cache=True, nogil=True)
-def stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_adapt, threshold, negative, gain,
-                  normals, cv_scale, noisy, signed):
+def stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_adapt, thresholded, threshold, negative,
+                 gain, normals, cv_scale, noisy, signed):
     """The linear part of a type's stage: filter (on the deviation from ``offset``), then `stage_tail`.
 
-    ``zi`` has shape (n_sections, 2, n_afferents); every state array is
-    updated in place.
+    ``zi`` has shape (n_sections, 2, n_afferents); ``threshold`` one dead
+    zone per afferent (see `stage_tail`); every state array is updated in place.
     """
     n_samples, m = f_a.shape
     out, cur = np.empty_like(f_a), np.empty(m)
@@ -145,8 +148,8 @@ def stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_ada
         for j in range(m):
             cur[j] = f_a[n, j] - offset[j]
         filter_sections(cur, 0, m, sections, 0, sos.shape[0], z)
-        stage_tail(cur, 0, m, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, threshold, negative, gain,
-                   normals, n, cv_scale, noisy, signed)
+        stage_tail(cur, 0, m, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, thresholded, threshold, negative,
+                   gain, normals, n, cv_scale, noisy, signed)
         out[n] = cur
     return out
 

@@ -209,7 +209,8 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
     slow = np.zeros(m)
     # The stage kernel with order 0, unit gain and a signed drive returns exactly deviation + offset.
     y = stage_kernel(_stage_sos(shared, float(fs)), np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow,
-                      float(fs), 0, 0.0, 0.0, 0.0, 1.0, np.ones(m), _NO_NORMALS, np.ones(m), False, True)
+                      float(fs), 0, 0.0, 0.0, False, np.zeros(m), 1.0, np.ones(m), _NO_NORMALS, np.ones(m), False,
+                      True)
     return y, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2, slow=slow, smooth=state.smooth)
 
 

@@ -119,6 +119,7 @@ __all__ = [
     "bias_multiplier",
     "tonic_current",
     "initial_phase",
+    "unit_thresholds",
 ]
 # The type vocabulary (`afferent_types`), the parameters (`current_params`), the filters
 # (`current_filters`) and the keyed draws (`variability`) live in modules of their own; every name
@@ -132,6 +133,7 @@ def afferent_current(
     params: CurrentParams = CurrentParams(),
     state: FilterState | None = None,
     scale=None,
+    sensitivity=None,
 ):
     """Input current of afferents of one type (eqs 1-3, or the type's own stage).
 
@@ -151,6 +153,11 @@ def afferent_current(
     scale : array_like, shape (n_afferents,), optional
         Per-afferent multiplier of the drive (gain variability, receptive
         field weight), applied before the transducer.
+    sensitivity : array_like, shape (n_afferents,), optional
+        Each afferent's sensitivity (dimensionless, > 0; default 1): it
+        multiplies the gain and divides the type's dead zone (``threshold_rai``),
+        so the unit's stimulus thresholds are its type's over its
+        sensitivity (docs/model.md, "Units that differ").
 
     Returns
     -------
@@ -171,11 +178,16 @@ def afferent_current(
     fs = check_positive(fs, "fs", "Hz")
     f_a = as_finite_array(f_a, "f_a", ndim=2)
     check_fs(fs, params, (afferent_type,))
-    return current_core(f_a, fs, afferent_type, params, state, scale)
+    if sensitivity is not None:
+        sensitivity = as_finite_array(sensitivity, "sensitivity", ndim=1)
+        if sensitivity.shape != (f_a.shape[1],) or np.any(sensitivity <= 0):
+            raise ValueError(f"sensitivity must hold one number > 0 per afferent ({f_a.shape[1]}), got shape "
+                             f"{sensitivity.shape}, smallest {float(np.min(sensitivity, initial=np.inf)):g}")
+    return current_core(f_a, fs, afferent_type, params, state, scale, sensitivity=sensitivity)
 
 
 def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals=None, noise_cv=None, excite=None,
-                 afferent_id=None):
+                 afferent_id=None, sensitivity=None):
     """`afferent_current` without validation (the hot path of `simulate`).
 
     ``normals`` (shape (n_afferents, n_samples), standard normal draws) and
@@ -188,11 +200,14 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     multiplies the trial's current after the log compression and before
     the bound ``i_max`` (`transduce_inplace`).  ``afferent_id`` (int array)
     keys the per-unit spread of the tonic current (`bias_multiplier`); None:
-    no spread.
+    no spread.  ``sensitivity`` (per afferent, dimensionless) multiplies the
+    gain and divides the dead zone (`unit_thresholds`); None: 1.
     """
     fs = float(fs)
     st, sos, alpha_adapt, alpha_smooth = type_filter_constants(params, afferent_type, fs)
     gain = st.gain if scale is None else st.gain * np.asarray(scale, dtype=float)
+    if sensitivity is not None:
+        gain = gain * np.asarray(sensitivity, dtype=float)
     noisy = normals is not None and noise_cv is not None and bool(np.any(np.asarray(noise_cv) > 0))
     if st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None:
         drive = gain * np.abs(f_a)  # the paper's eq. 1, no filter
@@ -205,11 +220,29 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     gain = gain if np.ndim(gain) else np.full(m, gain)
     cv_scale = np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs) if noisy else gain
     drive = stage_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, fs, st.derivative,
-                         float(st.adapt), alpha_adapt, float(st.threshold), float(st.negative_weight), gain,
+                         float(st.adapt), alpha_adapt, st.threshold > 0.0, unit_thresholds(st, sensitivity, m),
+                         float(st.negative_weight), gain,
                          np.ascontiguousarray(normals) if noisy else _NO_NORMALS, cv_scale, noisy, st.signed)
     current = transduce_inplace(drive, st, excite)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
     current, smooth, dyn = _after_transducer(current, st, state, m, fs, alpha_smooth, afferent_id)
     return current, FilterState(zi, state.offset, y1, y2, slow, smooth, dyn)
+
+
+def unit_thresholds(stage: TypeCurrentParams, sensitivity, n: int) -> np.ndarray:
+    """Each afferent's dead zone in its drive's units: the type's ``threshold`` over its sensitivity.
+
+    ``sensitivity`` is per afferent (dimensionless, > 0) or None (1 for
+    every afferent: the type's threshold, bit for bit).
+
+    Examples
+    --------
+    >>> st = CurrentParams(threshold_rai=1.0).for_type("RAI")
+    >>> unit_thresholds(st, np.array([0.5, 2.0]), 2).tolist()
+    [2.0, 0.5]
+    """
+    if sensitivity is None:
+        return np.full(n, float(stage.threshold))
+    return float(stage.threshold) / np.asarray(sensitivity, dtype=float)
 
 
 def _after_transducer(current, st, state, m, fs, alpha_smooth, afferent_id):

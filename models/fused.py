@@ -42,11 +42,13 @@ from ddmm.models._fused_drive import (
     _BIAS,
     _COS,
     _CV,
+    _DEAD,
     _DYN,
     _DYNC,
     _FALL,
     _GAIN,
     _K,
+    _N_AFF_ROWS,
     _N_STATE,
     _NEGATIVE,
     _NO_FORCES,
@@ -94,7 +96,7 @@ from ddmm.models._stage_kernels import (
     transduce_inplace,
 )
 from ddmm.models.attenuation import UNTUNED
-from ddmm.models.currents import excitability, initial_phase, type_filter_constants, tonic_current
+from ddmm.models.currents import excitability, initial_phase, tonic_current, type_filter_constants, unit_thresholds
 from ddmm.models.engines import NeuronState, check_integration, check_stability, get_engine, run_checked, substeps_for
 from ddmm.models.engines.direct import BLOCK, METHOD_CODES, integrate_parts, integrate_range, part_bounds, spike_checks
 from ddmm.models.nap import get_profile, tip_radius
@@ -152,7 +154,7 @@ def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, st
     y1, y2, slow = state[rows + _Y1], state[rows + _Y2], state[rows + _SLOW]
     f, words, xi, af = np.empty(m), np.empty(m, np.uint64), np.empty(m), np.empty(m)
     mags, wts, local = np.empty(m), np.empty(m), np.empty((3, m))
-    gain, cv_scale, two_fth = aff_f[_GAIN], aff_f[_CV], 2.0 * f_th
+    gain, cv_scale, dead, two_fth = aff_f[_GAIN], aff_f[_CV], aff_f[_DEAD], 2.0 * f_th
     af_ux, af_uy = np.full(grp_i.shape[1], np.nan), np.full(grp_i.shape[1], np.nan)  # direction of each group's af
     for i in range(n):
         fz, mag, ux, uy, w = 0.0, 0.0, 0.0, 0.0, 0.0
@@ -184,8 +186,8 @@ def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, st
             f[lo:hi] -= offset[lo:hi]
             filter_sections(f, lo, hi, sos, g, grp_i[_NSEC, g], z)
             stage_tail(f, lo, hi, offset, y1, y2, slow, fs, grp_i[_ORDER, g], grp_f[_ADAPT, g],
-                       grp_f[_ALPHA_ADAPT, g], grp_f[_THRESHOLD, g], grp_f[_NEGATIVE, g], gain, _NO_NORMALS, i,
-                       cv_scale, False, grp_i[_SIGNED, g] != 0)
+                       grp_f[_ALPHA_ADAPT, g], grp_f[_THRESHOLD, g] > 0.0, dead, grp_f[_NEGATIVE, g], gain,
+                       _NO_NORMALS, i, cv_scale, False, grp_i[_SIGNED, g] != 0)
             if noisy_any and grp_i[_NOISY, g] != 0:
                 receptor_noise_keyed(f, lo, hi, key, ids, sample0 + i, cv_scale, grp_i[_SIGNED, g] != 0, words,
                                      xi)
@@ -284,6 +286,9 @@ class FusedPipeline:
     neuron : dict, optional
         `ddmm.models.neuron.NeuronParams` by type code, overriding
         `NEURON_PARAMS` (both engines integrate with them).
+    sensitivity : array_like of float, optional
+        Each afferent's sensitivity (dimensionless, > 0; default 1): it
+        multiplies the gain and divides the dead zone (`unit_thresholds`).
 
     Examples
     --------
@@ -294,7 +299,7 @@ class FusedPipeline:
     """
 
     def __init__(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, params, fs, no_shear, f_th,
-                 afferent_id=None, mixing=None, neuron=None):
+                 afferent_id=None, mixing=None, neuron=None, sensitivity=None):
         afferent_type, nap = np.asarray(afferent_type), np.asarray(nap)
         self.afferent_type, self._neuron_cache, self._bounds = afferent_type, {}, {}
         self.neuron = dict(neuron or {})  # `NeuronParams` overrides by type (eqs 4-6 otherwise)
@@ -311,7 +316,7 @@ class FusedPipeline:
         consts = [type_filter_constants(params, str(afferent_type[a]), self.fs) for a, _ in spans]
         noise_cv, noise_sigma = np.asarray(noise_cv, dtype=float), np.asarray(noise_sigma, dtype=float)
         self.aff_f = self._afferent_tables(afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma,
-                                                       spans, consts)
+                                           spans, consts, sensitivity)
         self.grp_f, self.grp_i, self.sos = self._group_tables(spans, consts, noise_cv, nap != UNTUNED)
         self.rows = 2 * self.sos.shape[1]
         self.additive = bool(np.any(noise_sigma > 0))
@@ -330,9 +335,10 @@ class FusedPipeline:
             else:
                 self.transducers.append((slice(int(a), int(b)), st))
 
-    def _afferent_tables(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, spans, consts):
+    def _afferent_tables(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, spans, consts,
+                         sensitivity):
         n = self.n_afferents
-        aff_f = np.zeros((13, n))
+        aff_f = np.zeros((_N_AFF_ROWS, n))
         tuned = nap != UNTUNED
         rad = np.deg2rad(np.asarray(theta_t, dtype=float))
         aff_f[_COS], aff_f[_SIN], aff_f[_K] = np.cos(rad), np.sin(rad), np.asarray(k, dtype=float)
@@ -342,8 +348,12 @@ class FusedPipeline:
             aff_f[_P1:_P5 + 1, rows] = np.array([profile.p1, profile.p2, profile.p3, profile.p4, profile.p5])[:, None]
             aff_f[_TIP, rows] = tip_radius(str(name))
         scale = np.asarray(scale, dtype=float)
+        sens = None if sensitivity is None else np.asarray(sensitivity, dtype=float)
         for (a, b), (stage, *_) in zip(spans, consts):
             aff_f[_GAIN, a:b] = stage.gain * scale[a:b]  # as `current_core`
+            if sens is not None:
+                aff_f[_GAIN, a:b] *= sens[a:b]
+            aff_f[_DEAD, a:b] = unit_thresholds(stage, None if sens is None else sens[a:b], b - a)
             aff_f[_TONIC, a:b] = tonic_current(stage, self.afferent_id[a:b], b - a)  # as `current_core`
         aff_f[_CV] = noise_cv / np.sqrt(1000.0 / self.fs)  # as `current_core` and `_receptor_noise`
         aff_f[_SIGMA] = noise_sigma / np.sqrt(1000.0 / self.fs)  # as `noise_current`

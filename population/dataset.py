@@ -5,7 +5,7 @@ Schema (names are fixed):
 * dims ``condition`` (one per scene), ``trial``, ``afferent``, ``spike``
   (events) and ``time`` (force samples);
 * coords on ``afferent``: ``afferent`` (the stable afferent id),
-  ``afferent_type``, ``theta_t`` (deg), ``nap``, ``k``, ``gain``, ``x_mm``,
+  ``afferent_type``, ``theta_t`` (deg), ``nap``, ``k``, ``gain``, ``sensitivity``, ``x_mm``,
   ``y_mm``, ``noise_sigma``, ``noise_cv``, ``region`` (hand-map region, ``""``
   when unknown) and ``frame_deg`` (deg, local digit frame to hand frame); on ``condition``: ``condition`` (scene name),
   ``duration`` (s), ``theta_r`` (deg) with ``has_theta_r`` (1 when the scene
@@ -85,6 +85,11 @@ def model_attrs(population, config) -> dict:
     return attrs
 
 
+#: Attributes of the ``sensitivity`` coordinate.
+SENSITIVITY_ATTRS = {"units": "1", "long_name": "per-unit sensitivity: multiplies the gain, divides the type's "
+                                                "dead zone (1: the type's thresholds)"}
+
+
 def _afferent_coords(population, index) -> dict:
     pop = population
     coords = {
@@ -94,6 +99,7 @@ def _afferent_coords(population, index) -> dict:
         "nap": ("afferent", pop.nap[index].astype(object), {"long_name": "neural attenuation profile"}),
         "k": ("afferent", pop.k[index].astype(float), {"units": "1", "note": "0 for untuned afferents"}),
         "gain": ("afferent", pop.gain[index].astype(float), {"units": "1"}),
+        "sensitivity": ("afferent", pop.sensitivity[index].astype(float), SENSITIVITY_ATTRS),
         "x_mm": ("afferent", pop.x_mm[index].astype(float), {"units": "mm"}),
         "y_mm": ("afferent", pop.y_mm[index].astype(float), {"units": "mm"}),
         "noise_sigma": ("afferent", pop.noise_sigma[index].astype(float),
@@ -300,13 +306,19 @@ def save_dataset(ds: xr.Dataset, path) -> Path:
 
 
 def load_dataset(path) -> xr.Dataset:
-    """Read a dataset written by `save_dataset` fully into memory."""
+    """Read a dataset written by `save_dataset` fully into memory.
+
+    A dataset written before units had a sensitivity gets ``sensitivity`` 1
+    for every afferent (what its run used).
+    """
     ds = read_netcdf(path, "dataset file")
     if "afferent" not in ds.dims or "ddmm_version" not in ds.attrs:
         array = ds.attrs.get("layout") == "ddmm sensor array"
         raise ValueError(f"dataset file {str(path)!r} is not a ddmm simulation dataset (no afferent dimension"
                          + ("; it is a sensor-array file: simulate it with 'ddmm simulate --scene FILE')"
                             if array else ")"))
+    if "sensitivity" not in ds.variables:
+        ds = ds.assign_coords(sensitivity=("afferent", np.ones(ds.sizes["afferent"]), SENSITIVITY_ATTRS))
     return ds
 
 

@@ -33,7 +33,9 @@ from ddmm.population.spec import (
 __all__ = ["Population", "sample_population", "make_population"]
 
 _ARRAYS = ("afferent_type", "theta_t", "nap", "k", "gain", "x_mm", "y_mm", "noise_sigma", "noise_cv",
-           "afferent_id", "region", "frame_deg")
+           "afferent_id", "region", "frame_deg", "sensitivity")
+#: Spawn-key tag of the per-unit sensitivity streams ("sens" in ASCII): apart from every other draw.
+SENSITIVITY_TAG = 0x73656E73
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,6 +69,10 @@ class Population:
     frame_deg : ndarray of float
         Counterclockwise rotation (deg) from the afferent's local digit frame
         to the hand frame (0 for D2, the palm and unknown regions).
+    sensitivity : ndarray of float
+        Per-afferent sensitivity (dimensionless, > 0; default 1): it
+        multiplies the gain and divides the type's dead zone, so the unit's
+        stimulus thresholds are its type's over it (`TypeSpec.sensitivity_sd`).
     current : CurrentParams
         Gains and filter of eqs 1-3 shared by the population.
     name : str
@@ -91,6 +97,7 @@ class Population:
     afferent_id: np.ndarray
     region: np.ndarray = None
     frame_deg: np.ndarray = None
+    sensitivity: np.ndarray = None
     current: CurrentParams = field(default_factory=CurrentParams)
     name: str = "custom"
     receptive_field: str = "gaussian"
@@ -104,6 +111,8 @@ class Population:
             object.__setattr__(self, "region", np.full(n, "", dtype=object))
         if self.frame_deg is None:
             object.__setattr__(self, "frame_deg", np.zeros(n))
+        if self.sensitivity is None:
+            object.__setattr__(self, "sensitivity", np.ones(n))
         for name in _ARRAYS:
             arr = np.asarray(getattr(self, name), dtype=object if name == "region" else None)
             if arr.shape != (n,):
@@ -153,10 +162,12 @@ def _validate_values(pop: Population) -> None:
     if not all(issubclass(t, str) for t in set(map(type, pop.region.tolist()))):  # per type: C-speed
         bad = next(r for r in pop.region.tolist() if not isinstance(r, str))
         raise ValueError(f"population region must hold strings ('' when unknown), got {bad!r}")
-    for name in ("theta_t", "gain", "x_mm", "y_mm", "noise_sigma", "noise_cv", "k", "frame_deg"):
+    for name in ("theta_t", "gain", "x_mm", "y_mm", "noise_sigma", "noise_cv", "k", "frame_deg", "sensitivity"):
         arr = np.asarray(getattr(pop, name), dtype=float)
         if not np.all(np.isfinite(arr)):
             raise ValueError(f"population {name} must be finite")
+    if np.any(pop.sensitivity <= 0):
+        raise ValueError(f"population sensitivity must be > 0, got {float(np.min(pop.sensitivity)):g}")
     if np.any(pop.gain < 0) or np.any(pop.noise_sigma < 0) or np.any(pop.noise_cv < 0):
         raise ValueError("population gain, noise_sigma and noise_cv must be >= 0")
     for profile in PROFILE_NAMES:
@@ -248,6 +259,25 @@ def _sample_type(kind: str, spec: TypeSpec, n: int, place, rng) -> dict:
     }
 
 
+def _sample_sensitivity(sd: float, n: int, kind: str, rng) -> np.ndarray:
+    """Each unit's sensitivity, lognormal with median 1 and log-SD ``sd``, from its own stream.
+
+    The stream is keyed by the seed's `numpy.random.SeedSequence`, a tag and
+    the type, so the other draws of a seed (positions, theta_T, NAP, k, gain)
+    are the same with any spread; a generator without a seed sequence gives
+    a key drawn from it after every other draw.
+    """
+    if sd == 0.0 or n == 0:
+        return np.ones(n)
+    seq = getattr(rng.bit_generator, "seed_seq", None)
+    tag = (SENSITIVITY_TAG, AFFERENT_TYPES.index(kind))
+    if isinstance(seq, np.random.SeedSequence):
+        seq = np.random.SeedSequence(seq.entropy, spawn_key=tuple(seq.spawn_key) + tag, pool_size=seq.pool_size)
+    else:
+        seq = np.random.SeedSequence(int(rng.integers(2**63)), spawn_key=tag)
+    return np.exp(sd * np.random.default_rng(seq).standard_normal(n))
+
+
 def _placements(spec: PopulationSpec) -> dict:
     """Per type: (count, placement function)."""
     if spec.map is None:
@@ -289,12 +319,14 @@ def sample_population(spec, rng=None) -> Population:
     parts = [_sample_type(kind, tspec, *placements[kind], rng) for kind, tspec in spec.types.items()]
     arrays = {name: np.concatenate([p[name] for p in parts]) for name in parts[0]}
     n = len(arrays["theta_t"])
+    arrays["sensitivity"] = np.concatenate([_sample_sensitivity(tspec.sensitivity_sd, len(p["theta_t"]), kind, rng)
+                                            for p, (kind, tspec) in zip(parts, spec.types.items())])
     return Population(**arrays, afferent_id=np.arange(n, dtype=np.int64), current=spec.current, name=spec.name,
                       receptive_field=spec.receptive_field, neuron=dict(spec.neuron))
 
 
 def make_population(afferent_type, theta_t=0.0, nap=UNTUNED, k=3.0, *, gain=1.0, x_mm=0.0, y_mm=0.0,
-                    noise_sigma=0.0, noise_cv=0.0, region="", frame_deg=0.0,
+                    noise_sigma=0.0, noise_cv=0.0, region="", frame_deg=0.0, sensitivity=1.0,
                     current: CurrentParams = CurrentParams(), name="custom",
                     receptive_field: str = "gaussian") -> Population:
     """Build a population from explicit per-afferent values (scalars broadcast).
@@ -312,7 +344,8 @@ def make_population(afferent_type, theta_t=0.0, nap=UNTUNED, k=3.0, *, gain=1.0,
     k = np.where(nap == UNTUNED, 0.0, np.broadcast_to(np.asarray(k, float), (n,)))
     arrays = {name: np.broadcast_to(np.asarray(v, float), (n,)).copy()
               for name, v in (("theta_t", theta_t), ("gain", gain), ("x_mm", x_mm), ("y_mm", y_mm),
-                              ("noise_sigma", noise_sigma), ("noise_cv", noise_cv), ("frame_deg", frame_deg))}
+                              ("noise_sigma", noise_sigma), ("noise_cv", noise_cv), ("frame_deg", frame_deg),
+                              ("sensitivity", sensitivity))}
     region = np.array(np.broadcast_to(np.asarray(region, dtype=object), (n,)))
     return Population(afferent_type=types, nap=np.array(nap), k=k, afferent_id=np.arange(n, dtype=np.int64),
                       region=region, current=current, name=name, receptive_field=receptive_field, **arrays)

@@ -119,7 +119,7 @@ def block_pipeline(population, fs: float, sites, scale, no_shear: str):
         indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, sites, pop.receptive_field)
         mixing = mixing_matrix(indptr, indices, coeff, len(sites))
     return FusedPipeline(pop.afferent_type, pop.nap, theta, pop.k, scale, pop.noise_cv, pop.noise_sigma, pop.current,
-                     fs, no_shear, F_TH, pop.afferent_id, mixing, pop.neuron)
+                         fs, no_shear, F_TH, pop.afferent_id, mixing, pop.neuron, pop.sensitivity)
 
 
 def chunk_forces(scene, sl: slice) -> np.ndarray:

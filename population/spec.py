@@ -258,6 +258,10 @@ class MapSpec:
         return hand_map.region_counts(tuple(afferent_types), self.region_names())
 
 
+#: Largest ``sensitivity_sd``: a q90/q10 threshold ratio of about 600, beyond any reported spread.
+MAX_SENSITIVITY_SD = 2.5
+
+
 @dataclass(frozen=True)
 class TypeSpec:
     """How the afferents of one type are drawn.
@@ -277,6 +281,14 @@ class TypeSpec:
         `SharpnessDistribution` per profile (default: k = 3).
     gain_cv : float
         Coefficient of variation of the per-afferent gain (lognormal, mean 1).
+    sensitivity_sd : float
+        Spread of the per-afferent sensitivity: the SD of its natural log
+        (lognormal, median 1; 0: every unit 1, the paper).  A unit's
+        sensitivity multiplies its gain and divides its type's dead zone, so
+        its stimulus thresholds are its type's divided by it; the q90/q10
+        ratio of thresholds is ``exp(2.563 sensitivity_sd)`` (docs/model.md,
+        "Units that differ").  Drawn from a stream keyed by the seed and the
+        type, apart from every other draw.
     noise_sigma : float
         Additive white current-noise intensity in mV/sqrt(ms): each current
         sample of length h ms gets ``noise_sigma * N(0, 1) / sqrt(h)``, so the
@@ -296,6 +308,7 @@ class TypeSpec:
     nap: dict = field(default_factory=lambda: {UNTUNED: 1.0})
     sharpness: dict = field(default_factory=lambda: dict(DEFAULT_SHARPNESS))
     gain_cv: float = 0.0
+    sensitivity_sd: float = 0.0
     noise_sigma: float = 0.0
     noise_cv: float = 0.0
 
@@ -324,6 +337,11 @@ class TypeSpec:
                 _fail(f"sharpness.{name}", f"unknown profile; allowed: {', '.join(PROFILE_NAMES)}")
         object.__setattr__(self, "sharpness", sharp)
         _finite("gain_cv", self.gain_cv, nonneg=True)
+        _finite("sensitivity_sd", self.sensitivity_sd, nonneg=True)
+        if self.sensitivity_sd > MAX_SENSITIVITY_SD:
+            _fail("sensitivity_sd", f"must be <= {MAX_SENSITIVITY_SD:g} (thresholds spread over a factor of "
+                                    f"{math.exp(2.563 * MAX_SENSITIVITY_SD):,.0f} from q10 to q90), "
+                                    f"got {self.sensitivity_sd:g}")
         _finite("noise_sigma", self.noise_sigma, nonneg=True)
         _finite("noise_cv", self.noise_cv, nonneg=True)
 

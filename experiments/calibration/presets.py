@@ -226,7 +226,7 @@ def spec_to_toml(spec, header: str = "") -> str:
     for kind, t in spec.types.items():
         lines += ["", f"[types.{kind}]", *_count_toml(t),
                   f"noise_sigma = {_toml_value(t.noise_sigma)}", f"noise_cv = {_toml_value(t.noise_cv)}",
-                  f"gain_cv = {_toml_value(t.gain_cv)}",
+                  f"gain_cv = {_toml_value(t.gain_cv)}", f"sensitivity_sd = {_toml_value(t.sensitivity_sd)}",
                   f"theta_t = {_toml_value({k: v for k, v in dataclasses.asdict(t.theta_t).items() if v not in ((), 0.0) or k == 'distribution'})}",
                   f"nap = {_toml_value(dict(t.nap))}", f"[types.{kind}.sharpness]"]
         for profile, dist in t.sharpness.items():

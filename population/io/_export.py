@@ -22,6 +22,8 @@ AFFERENT_FIELDS = (
     ("nap", "1", "direction profile (NAP): selective, broad, bipolar or none (unitless label)"),
     ("k", "1", "tuning sharpness k (dimensionless; 0 for untuned afferents)"),
     ("gain", "1", "per-afferent current gain (dimensionless, mean 1)"),
+    ("sensitivity", "1", "per-afferent sensitivity (dimensionless, median 1): multiplies the gain and divides the "
+                         "type's dead zone, so the unit's stimulus thresholds are its type's over it"),
     ("x_mm", "mm", "receptor position x in millimetres (+X radial)"),
     ("y_mm", "mm", "receptor position y in millimetres (+Y distal)"),
     ("region", "1", "hand-map region (ddmm.population.anatomy.hand_map), empty when unknown (unitless label)"),
@@ -30,7 +32,10 @@ AFFERENT_FIELDS = (
     ("noise_cv", "sqrt(ms)", "receptor (drive-proportional) noise intensity in sqrt(ms)"),
 )
 _LABELS = {"afferent_type", "nap", "region"}
-_REQUIRED = ("afferent", *(name for name, _, _ in AFFERENT_FIELDS), "condition", "duration", "theta_r",
+#: Fields a Dataset of an older version may lack, with the value its run used.
+_OPTIONAL = {"sensitivity": 1.0}
+_REQUIRED = ("afferent", *(name for name, _, _ in AFFERENT_FIELDS if name not in _OPTIONAL), "condition", "duration",
+             "theta_r",
              "has_theta_r", "trial", "spike_count")
 _EVENTS = ("spike_time", "spike_afferent", "spike_trial", "spike_condition")
 
@@ -68,6 +73,9 @@ def afferent_values(dataset) -> dict:
     """Every field of `AFFERENT_FIELDS` as a list of plain Python str / float, plus ``afferent_id`` (int)."""
     out = {"afferent_id": [int(v) for v in dataset["afferent"].values]}
     for name, _, _ in AFFERENT_FIELDS:
+        if name not in dataset.variables:  # an older Dataset: the value its run used
+            out[name] = [_OPTIONAL[name]] * len(out["afferent_id"])
+            continue
         values = dataset[name].values
         out[name] = [str(v) for v in values] if name in _LABELS else [float(v) for v in values]
     return out

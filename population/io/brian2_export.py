@@ -12,7 +12,8 @@ Layout of the group `to_brian2` returns:
 * numeric afferent metadata as read-only Brian2 variables, usable in
   ``Synapses.connect(condition=...)`` (with ``_pre``), in
   ``Synapses(on_pre=...)`` and as ``group.x_mm[:]``: ``afferent_id``,
-  ``x_mm``, ``y_mm`` (mm) and ``theta_t`` (deg), stored as plain numbers;
+  ``x_mm``, ``y_mm`` (mm), ``theta_t`` (deg), ``k``, ``gain`` and
+  ``sensitivity`` (dimensionless; 1 for a Dataset older than it), stored as plain numbers;
 * text metadata as read-only numpy arrays on the group (Brian2 variables
   are numeric): ``afferent_type``, ``nap`` and ``region``, to select
   presynaptic indices, e.g. ``i=np.flatnonzero(group.afferent_type ==
@@ -37,7 +38,8 @@ __all__ = ["to_brian2"]
 
 _TOL = 1e-6  # fraction of a step: a time this close below a step boundary counts as on it
 _VARIABLES = (("afferent_id", "afferent", np.int64), ("x_mm", "x_mm", np.float64), ("y_mm", "y_mm", np.float64),
-              ("theta_t", "theta_t", np.float64))  # (Brian2 variable, Dataset coord, dtype)
+              ("theta_t", "theta_t", np.float64), ("k", "k", np.float64), ("gain", "gain", np.float64),
+              ("sensitivity", "sensitivity", np.float64))  # (Brian2 variable, Dataset coord, dtype)
 _LABELS = ("afferent_type", "nap", "region")
 
 
@@ -213,7 +215,8 @@ def _attach(group, dataset, pairs, offsets_s) -> None:
     """Afferent metadata (read-only Brian2 variables and numpy attributes), ``pairs`` and ``offsets`` on ``group``."""
     n = group.N
     for variable, coord, dtype in _VARIABLES:
-        group.variables.add_array(variable, size=n, values=np.asarray(dataset[coord].values, dtype), dtype=dtype,
+        values = dataset[coord].values if coord in dataset.variables else np.ones(n)  # older: sensitivity 1
+        group.variables.add_array(variable, size=n, values=np.asarray(values, dtype), dtype=dtype,
                                   constant=True, read_only=True)
     arrays = {label: np.asarray(dataset[label].values).astype(str) for label in _LABELS}
     arrays.update(pairs=pairs, offsets=np.asarray(offsets_s, np.float64))

@@ -10,7 +10,7 @@ Layout:
 * in each segment one ``SpikeTrain`` per afferent (in the Dataset's
   afferent order) in s from the trial's start, ``t_start = 0``, ``t_stop`` =
   the condition's duration, annotated with ``afferent_id``,
-  ``afferent_type``, ``theta_t``, ``nap``, ``k``, ``gain``, ``x_mm``,
+  ``afferent_type``, ``theta_t``, ``nap``, ``k``, ``gain``, ``sensitivity``, ``x_mm``,
   ``y_mm``, ``region``, ``frame_deg``, ``noise_sigma`` and ``noise_cv``
   (plain floats; their units are in the block's ``afferent_units``
   annotation: deg, mm, ...);

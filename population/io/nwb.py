@@ -13,7 +13,7 @@ Layout (core NWB types only, no extension):
 * **Units** (``nwbfile.units``): one row per afferent, ``id`` = the stable
   afferent id; ``spike_times`` over all trials on the session clock;
   ``resolution`` = the integration step dt (s).  Columns ``afferent_id``,
-  ``afferent_type``, ``theta_t`` (deg), ``nap``, ``k``, ``gain``, ``x_mm`` and
+  ``afferent_type``, ``theta_t`` (deg), ``nap``, ``k``, ``gain``, ``sensitivity``, ``x_mm`` and
   ``y_mm`` (mm), ``region``, ``frame_deg`` (deg), ``noise_sigma``
   (mV/sqrt(ms)) and ``noise_cv`` (sqrt(ms)); each description names its unit.
 * **Trials** (``nwbfile.trials``): ``start_time``, ``stop_time`` (s),

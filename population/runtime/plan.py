@@ -179,7 +179,7 @@ def _unit_keys(pop, sel, tuned, scale, local):
     nap_code = np.where(tuned, np.unique(pop.nap, return_inverse=True)[1][sel], -1).astype(float)
     theta = np.where(tuned, pop.theta_t[sel], 0.0)
     k = np.where(tuned, pop.k[sel], 0.0)
-    columns = [type_code, nap_code, theta, k, scale]
+    columns = [type_code, nap_code, theta, k, scale, pop.sensitivity[sel]]  # sensitivity: gain and dead zone
     if pop.current.bias_cv_saii > 0.0:  # each SA-II's own tonic current (`bias_multiplier`)
         tonic = pop.afferent_type[sel] == "SAII"
         columns.append(np.where(tonic, bias_multiplier(pop.current.bias_cv_saii, pop.afferent_id[sel]), 1.0))
