@@ -48,17 +48,17 @@ def plot_on_off(data: dict, bin_s: float = 0.02) -> Figure:
 
 
 def plot_force_coding(data: dict) -> Figure:
-    """SA-I plateau rate against normal force, FA-I loading count against force rate."""
+    """SA-I plateau rate against normal force, FA-I mean rate while loading against force rate."""
     fig = Figure(figsize=(8.0, 3.2), layout="constrained")
     a, b = fig.subplots(1, 2)
     if "sai_plateau" in data:
         a.plot([1, 2, 4], data["sai_plateau"], "o-", color=TYPE_COLOURS["SAI"])
     a.set_xlabel("normal force (N)")
     a.set_ylabel("SA-I plateau rate (pulses/s)")
-    if "rai_loading_counts" in data:
-        b.semilogx([2, 8, 32], data["rai_loading_counts"], "o-", color=TYPE_COLOURS["RAI"])
+    if "rai_loading_rates" in data:
+        b.loglog([2, 8, 32], np.maximum(data["rai_loading_rates"], 0.1), "o-", color=TYPE_COLOURS["RAI"])
     b.set_xlabel("force rate (N/s)")
-    b.set_ylabel("FA-I spikes during loading")
+    b.set_ylabel("FA-I mean rate while loading (pulses/s)")
     return fig
 
 

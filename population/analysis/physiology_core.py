@@ -11,7 +11,7 @@ Protocols (forces in N, +Z into the skin; the frame of `ddmm.population.stimuli.
 * ``rates``: every scene the package ships (`shipped_scenes`): the largest
   instantaneous rate (1/ISI) and spikes on consecutive integration steps.
 * ``force_coding``: SA-I plateaus at 1, 2 and 4 N (2 N/s ramps); RA-I
-  loading at 2, 8 and 32 N/s to 4 N.
+  mean rates while loading at 2, 8 and 32 N/s to 4 N.
 * ``frequency``: sinusoidal normal force on a 1 N preload, 5-400 Hz, sampled
   at 5 kHz; per afferent the amplitude for one spike per cycle.
 * ``direction``: the Birznieks protocol (`ddmm.population.analysis.tuning`).
@@ -54,9 +54,11 @@ PROPERTIES = dict([
     _p("max_rate_SAII", "SAII", "rates", "largest 1/ISI on the shipped scenes", "1/s"),
     _p("capped_spikes", "all", "rates", "spikes on consecutive integration steps"),
     _p("force_coding_SAI", "SAI", "force_coding", "smallest ratio of plateau rates, 1 -> 2 -> 4 N"),
-    _p("rate_coding_RAI", "RAI", "force_coding", "smallest ratio of loading counts, 2 -> 8 -> 32 N/s"),
-    _p("best_frequency_RAI", "RAI", "frequency", "frequency of the lowest one-spike-per-cycle amplitude", "Hz"),
-    _p("best_frequency_RAII", "RAII", "frequency", "frequency of the lowest one-spike-per-cycle amplitude", "Hz"),
+    _p("rate_coding_RAI", "RAI", "force_coding", "smallest ratio of mean loading rates, 2 -> 8 -> 32 N/s"),
+    _p("best_frequency_RAI", "RAI", "frequency",
+       "frequency of the lowest one-spike-per-cycle amplitude, each unit's relative to its own best", "Hz"),
+    _p("best_frequency_RAII", "RAII", "frequency",
+       "frequency of the lowest one-spike-per-cycle amplitude, each unit's relative to its own best", "Hz"),
     _p("tuned_SAI", "SAI", "direction", "fraction tuned (ANOVA per phase, p < 0.05)"),
     _p("tuned_RAI", "RAI", "direction", "fraction tuned (ANOVA per phase, p < 0.05)"),
     _p("dsi_mean_SAI", "SAI", "direction", "DSI mean"),
@@ -165,9 +167,12 @@ def _force_coding(population, context) -> dict:
     if len(ra):
         scenes = [_knots([0, 0.1, 0.1 + 4.0 / r, 0.4 + 4.0 / r], [0, 0, 4, 4], name=f"ramp_{r:g}") for r in (2, 8, 32)]
         ds = _run(ra, scenes, context)
-        counts = np.array([(_rates(ds, 0.1, 0.1 + 4.0 / r, c) * 4.0 / r).mean() for c, r in enumerate((2, 8, 32))])
-        out["rate_coding_RAI"] = float(np.min(counts[1:] / np.maximum(counts[:-1], 1e-12)))
-        data["rai_loading_counts"] = counts
+        # Mean rate over the ramp (spikes per second of loading), as human FA-I velocity coding is measured:
+        # a ramp to one force is 16x shorter at 32 N/s than at 2 N/s, so its count need not grow.
+        rates = np.array([_rates(ds, 0.1, 0.1 + 4.0 / r, c).mean() for c, r in enumerate((2, 8, 32))])
+        out["rate_coding_RAI"] = float(np.min(rates[1:] / np.maximum(rates[:-1], 1e-12)))
+        data["rai_loading_rates"] = rates
+        data["rai_loading_counts"] = rates * 4.0 / np.array([2.0, 8.0, 32.0])
     return out, data
 
 
@@ -216,6 +221,20 @@ def vibration_scene(frequency_hz: float, amplitude_n: float, name: str) -> Scene
     return Scene(zero, zero, fz, _VIBRATION_FS, name, (Stage("steady", _VIBRATION_WINDOW[0], _VIBRATION_WINDOW[1]),))
 
 
+def _relative_log(thresholds) -> np.ndarray:
+    """Log thresholds (frequency, afferent) relative to each afferent's own lowest; afferents that never lock
+    are dropped.
+
+    Units differ in sensitivity (`ddmm.population.Population.sensitivity`): each one's curve is its shape
+    times its own scale, and a median of absolute thresholds picks a different unit at each frequency.
+    Relative to its own best, every unit's curve is its shape alone.
+    """
+    with np.errstate(invalid="ignore"):
+        logs = np.log(thresholds)
+        keep = np.isfinite(logs).any(axis=0)
+        return logs[:, keep] - np.min(logs[:, keep], axis=0)
+
+
 def _frequency(population, context) -> dict:
     out, data = {}, {}
     for kind in ("RAI", "RAII"):
@@ -227,7 +246,7 @@ def _frequency(population, context) -> dict:
         scenes = [vibration_scene(f, a, f"vib_{f:g}_{i}") for f in FREQUENCIES_HZ for i, a in enumerate(AMPLITUDES_N)]
         ds = _run(sub, scenes, context, record=("spikes",))
         thresholds = _thresholds(ds, len(FREQUENCIES_HZ), len(AMPLITUDES_N))
-        curve = np.exp(np.median(np.log(thresholds), axis=1))  # median over afferents, inf-safe
+        curve = np.exp(np.median(_relative_log(thresholds), axis=1))  # median over afferents, inf-safe
         out[f"best_frequency_{kind}"] = float(FREQUENCIES_HZ[int(np.argmin(curve))])
         data[kind] = curve
     return out, data

@@ -98,7 +98,31 @@ def _physiology_reference() -> dict:
 def _dynamic_reference(R) -> dict:
     """Reference ranges of the protocol modules beyond the core battery (phase locking, variability, shear)."""
     return {**_vibration_reference(R), **_variability_reference(R), **_shear_reference(R), **_slow_reference(R),
-            **_field_reference(R)}
+            **_field_reference(R), **_everyday_reference(R)}
+
+
+def _everyday_reference(R) -> dict:
+    """Releases, recruitment and threshold spread at everyday touches (docs/references.md rows 3, 27-29;
+    `ddmm.population.analysis.physiology_everyday`)."""
+    inf = float("inf")
+    off = ("docs/references.md rows 3, 27: FA-I fire at unloading in ordinary grip and release (a few N/s), the "
+           "OFF burst usually smaller than the ON burst but present in most units")
+    rate = ("docs/references.md rows 28, 29: thresholds spread over an order of magnitude within a type, so "
+            "recruitment grows gradually with loading rate; FA-I respond to the slow loading of manipulation")
+    spread = "docs/references.md row 28: thresholds of one type differ by an order of magnitude or more"
+    chosen = "; threshold_rai set by hand to it"
+    return {
+        "release_2Ns_RAI": R(0.05, 1.0, off, "held out", "R"),
+        "release_4Ns_RAI": R(0.5, 1.0, off + chosen, "constrained", "R"),
+        "off_on_8Ns_RAI": R(0.2, 1.0, off, "held out", "R"),
+        "release_variant_RAI": R(0.5, 1.0, off + " (a variant: 4 N held 3 s)", "held out", "R"),
+        "release_conditioned_RAI": R(0.5, 2.0, "the same touch read as a recording: the default conditioning "
+                                     "must keep FA-I's release response (within a factor of 2)", "held out", "R"),
+        "recruit_2Ns_RAI": R(0.3, 1.0, rate, "held out", "R"),
+        "recruit_range_RAI": R(4.0, inf, rate + chosen, "constrained", "R"),
+        "threshold_spread_RAI": R(5.0, inf, spread + "; sensitivity_sd set to it", "constrained", "R"),
+        "threshold_spread_RAII": R(5.0, inf, spread + "; sensitivity_sd set to it", "constrained", "R"),
+    }
 
 
 def _field_reference(R) -> dict:
@@ -238,8 +262,8 @@ def _core_reference(R) -> dict:
         "capped_spikes": R(0.0, 0.0, "nothing near one spike per integration step", "constrained", "R"),
         "force_coding_SAI": R(1.05, inf, "docs/references.md row 6: SA-I rates rise with normal force (shape only)",
                               "held out", "V"),
-        "rate_coding_RAI": R(1.05, inf, "docs/references.md row 6: FA-I responses grow with indentation rate",
-                             "held out", "V"),
+        "rate_coding_RAI": R(1.05, inf, "docs/references.md rows 6, 29: FA-I discharge rates grow with indentation "
+                             "and loading rate", "held out", "V"),
         "best_frequency_RAI": R(8.0, 64.0, "docs/references.md row 8 (Johansson, Landstrom & Lundstrom 1982)",
                                 "held out", "V"),
         "best_frequency_RAII": R(200.0, 300.0, "docs/references.md row 8: FA-II best at 200-300 Hz; FA-II's high-pass "

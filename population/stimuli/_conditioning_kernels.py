@@ -53,19 +53,25 @@ def sos_filter(sos, x, zi):
 
 
 @nb.njit(cache=True, nogil=True)
-def hold_band(x, width, alpha, held):
-    """The shear hold, in place on the tangential columns of ``x`` (n, sites, 3); ``held`` (sites, 2) updated.
+def hold_band(x, widths, alpha, held):
+    """The force hold, in place on ``x`` (n, sites, 3); ``held`` (sites, 3) updated.
 
-    A play operator that re-centres: the output relaxes toward the input by
-    ``alpha`` per sample (a first-order low-pass, far slower than any
-    afferent cares about) and never strays more than ``width`` from it.  On
-    a hold the output settles on the hold's mean and barely moves; on a ramp
-    it moves with the ramp's slope, at most ``width`` behind.
+    A play operator per axis that re-centres: the output relaxes toward the
+    input by ``alpha`` per sample (a first-order low-pass, far slower than
+    any afferent cares about) and never strays more than ``widths[a]`` from
+    it (an axis of width 0 passes as it is).  On a hold the output settles
+    on the hold's mean and barely moves; on a ramp it moves with the ramp's
+    slope, at most the width behind.
     """
     for i in range(x.shape[0]):
         for s in range(x.shape[1]):
-            for a in range(2):
+            for a in range(3):
+                width = widths[a]
+                if width <= 0.0:
+                    continue
                 v = x[i, s, a]
+                if a == 2:
+                    width = min(width, max(v - widths[3], 0.0))
                 h = held[s, a] + alpha * (v - held[s, a])
                 held[s, a] = min(max(h, v - width), v + width)
                 x[i, s, a] = held[s, a]
@@ -81,20 +87,20 @@ def _gated(y, slow, kept, i, s, a, gate):
 
 
 @nb.njit(cache=True, nogil=True)
-def gate_hold_contact(y, slow, smooth, gate, width, alpha, held, on, off, deadband, state):
+def gate_hold_contact(y, slow, smooth, gate, widths, alpha, held, on, off, deadband, state):
     """The gate, the shear hold, contact and the shear deadband of one chunk (see the module docstring).
 
     ``y`` is the resampled recording (n, sites, 3); ``slow`` and ``smooth``
     are its tracker's slow band and that band smoothed (ignored when
-    ``gate`` is negative: no gate, the hold acts on ``y``; ``width`` and
-    ``alpha`` are `hold_band`'s).  ``held`` (sites,
-    2) and ``state`` (sites, bool contact) carry over between chunks.  Returns
+    ``gate`` is negative: no gate, the hold acts on ``y``; ``widths`` (per
+    axis) and ``alpha`` are `hold_band`'s).  ``held`` (sites, 3) and
+    ``state`` (sites, bool contact) carry over between chunks.  Returns
     the conditioned forces (n, sites, 3) and the contact (n, sites).
     """
     n, sites = y.shape[0], y.shape[1]
     kept = smooth.copy() if gate >= 0.0 else y.copy()
-    if width > 0.0:
-        hold_band(kept, width, alpha, held)
+    if widths[:3].max() > 0.0:
+        hold_band(kept, widths, alpha, held)
     out = np.empty_like(y)
     contact = np.empty((n, sites), dtype=np.bool_)
     for i in range(n):

@@ -16,15 +16,19 @@ it, so a stream and an offline run give the same numbers, bit for bit):
    interpolation would put a kink, an acceleration impulse, at every sample.
 2. **Noise gate** (``noise_n`` > 0): each axis is split by a ramp-following
    tracker of bandwidth ``slow_hz`` (`_tracker`) into a slow band, kept
-   (smoothed by a low-pass at 2 ``slow_hz``), and a fast band, soft-thresholded at ``4 noise_n``
+   (held, step 3, then smoothed by a low-pass at 2 ``slow_hz``), and a fast band, soft-thresholded at ``4 noise_n``
    (``sign(x) max(|x| - 4 noise_n, 0)``).  Sensor noise, almost all of it in
    the fast band, is removed, on a hold and during a ramp alike; a ramp's
    corners and a vibration larger than the threshold pass, smaller by the
    threshold.
-3. **Shear hold** (``shear_hold_n`` > 0): the kept band's tangential force
-   moves only when it leaves a band of +-``shear_hold_n`` around its last
-   value (a play operator, `hold_band`), and re-centres on the input at
-   0.5 Hz, so a hold is not left a width short.  On a sheared hold the slow
+3. **Force hold** (``shear_hold_n``, ``normal_hold_n`` > 0): the kept band's
+   tangential and normal force move only when they leave a band of
+   +-``shear_hold_n`` (tangential) or +-``normal_hold_n`` (normal) around
+   their last value (a play operator per axis, `hold_band`), and re-centre
+   on the input at 0.5 Hz, so a hold is not left a width short.  The normal
+   hold keeps the slow band's wander (9 mN SD, velocities up to 1 N/s at
+   100 Hz and 20 mN of noise) from reaching the most sensitive FA-I, whose
+   velocity thresholds reach 0.1-0.2 N/s.  On a sheared hold the slow
    band still carries smoothed noise (at 100 Hz, ten times more per hertz
    than at 1 kHz for the same per-sample SD), and the shear term of the
    presets multiplies it into FA-I's drive; held, the shear drifts at
@@ -91,6 +95,10 @@ class Conditioning:
         operator), so noise on a sheared hold cannot wobble the shear.  0
         turns it off.  Default 0.025 N (docs/recordings.md gives the
         measurement).
+    normal_hold_n : float
+        Width of the same hold on the normal force, newtons (0: off).
+        Default 0.025 N, the shear hold's: a ramp passes at most this far
+        behind (2.5 ms at 10 N/s, 12.5 ms at 2 N/s).
     mode : {"causal", "zero_phase"}
         Causal filters (offline and streaming) or forward-backward ones
         (offline only).
@@ -103,10 +111,11 @@ class Conditioning:
     contact_off_n: float = 0.015
     shear_deadband_n: float = 0.03
     shear_hold_n: float = 0.025
+    normal_hold_n: float = 0.025
     mode: str = "causal"
 
     def __post_init__(self):
-        for name in ("noise_n", "contact_off_n", "shear_deadband_n", "shear_hold_n"):
+        for name in ("noise_n", "contact_off_n", "shear_deadband_n", "shear_hold_n", "normal_hold_n"):
             _check_number(getattr(self, name), name, lambda x: x >= 0.0, ">= 0 (N)")
         _check_number(self.slow_hz, "slow_hz", lambda x: x > 0.0, "> 0 (Hz)")
         _check_number(self.contact_on_n, "contact_on_n", lambda x: x > self.contact_off_n,
@@ -239,22 +248,41 @@ class Conditioner:
         self._k += x.shape[0]
         if y.shape[0] == 0:
             return self._out(y, np.empty((0, sites), bool))
+        widths = hold_widths(self.settings)
         if self.settings.noise_n > 0:
             slow = self._filter(self._sos_slow, y, "_zi_slow")
-            kept, gate = self._filter(self._sos_smooth, slow, "_zi_smooth"), _GATE * self.settings.noise_n
+            # The normal hold acts before the smoothing, which rounds its corners: a corner of the held F_Z is
+            # a step of its velocity, and unsmoothed it drove FA-II in holds (0.3 pulses/s at 100 Hz, 20 mN).
+            # The shear hold stays after it (FA-I's shear term fired more in sheared holds the other way).
+            normal, shear = widths * [0.0, 0.0, 1.0, 1.0], widths * [1.0, 1.0, 0.0, 1.0]
+            kept = self._filter(self._sos_smooth, self._hold(slow, normal), "_zi_smooth")
+            gate, widths = _GATE * self.settings.noise_n, shear
         else:
             slow, kept, gate = y, y, -1.0
-        return self._out(*self._finish(y, slow, kept, gate, self.settings.shear_hold_n))
+        return self._out(*self._finish(y, slow, kept, gate, widths))
 
-    def _finish(self, y, slow, kept, gate, width):
-        """Gate, shear hold of ``width`` N, contact and deadband (`gate_hold_contact`), state carried over."""
+    def _hold(self, slow, widths):
+        """The force hold (`hold_band`) on a copy of the tracker's slow band, its state carried over."""
+        if widths[:3].max() <= 0.0:
+            return slow
+        sites = slow.shape[1] // 3
+        if self._held is None:
+            self._held = np.ascontiguousarray(slow[0].reshape(sites, 3))
+        held = slow.reshape(slow.shape[0], sites, 3).copy()
+        hold_band(held, widths, self._alpha, self._held)
+        return held.reshape(slow.shape)
+
+    def _finish(self, y, slow, kept, gate, widths):
+        """Gate, force hold of ``widths`` N per axis, contact and deadband (`gate_hold_contact`), state carried
+        over."""
         s, sites = self.settings, y.shape[1] // 3
         if self._contact is None:
             self._contact = np.zeros(sites, bool)
-            self._held = np.ascontiguousarray(kept[0].reshape(sites, 3)[:, :2])
+        if self._held is None:
+            self._held = np.ascontiguousarray(kept[0].reshape(sites, 3))
         shape = (y.shape[0], sites, 3)
         return gate_hold_contact(y.reshape(shape), slow.reshape(shape), kept.reshape(shape), gate,
-                                 width, self._alpha, self._held, s.contact_on_n, s.contact_off_n,
+                                 widths, self._alpha, self._held, s.contact_on_n, s.contact_off_n,
                                  s.shear_deadband_n, self._contact)
 
     def _out(self, y, contact):
@@ -309,20 +337,31 @@ def _zero_phase(forces, fs_in, fs_out, conditioning, n_sites):
     if conditioning.bandwidth_hz is not None and conditioning.bandwidth_hz < 0.45 * fs_out:
         y = sosfiltfilt(_lowpass(conditioning.bandwidth_hz, fs_out), y, axis=0, padlen=padlen)
     slow, kept, gate = y, y, -1.0
+    widths = hold_widths(conditioning)
     if conditioning.noise_n > 0:
         slow = sosfiltfilt(causal._sos_slow, y, axis=0, padlen=padlen)
-        kept, gate = sosfiltfilt(causal._sos_smooth, slow, axis=0, padlen=padlen), _GATE * conditioning.noise_n
-    kept = _hold_both_ways(np.ascontiguousarray(kept), conditioning.shear_hold_n, causal._alpha)
-    return causal._out(*causal._finish(np.ascontiguousarray(y), np.ascontiguousarray(slow), kept, gate, 0.0))
+        held = _hold_both_ways(np.ascontiguousarray(slow), widths * [0.0, 0.0, 1.0, 1.0], causal._alpha)
+        kept, gate = sosfiltfilt(causal._sos_smooth, held, axis=0, padlen=padlen), _GATE * conditioning.noise_n
+        widths = widths * [1.0, 1.0, 0.0, 1.0]
+    kept = _hold_both_ways(np.ascontiguousarray(kept), widths, causal._alpha)
+    return causal._out(*causal._finish(np.ascontiguousarray(y), np.ascontiguousarray(slow), kept, gate,
+                                       np.zeros(4)))
 
 
-def _hold_both_ways(kept, width, alpha):
-    """The shear hold run forwards and backwards, averaged: no lag, constant on a hold, as the other filters here."""
-    if width <= 0.0 or kept.shape[0] == 0:
+def hold_widths(conditioning: Conditioning) -> np.ndarray:
+    """The force hold's width per axis (x, y, z) in newtons."""
+    return np.array([conditioning.shear_hold_n, conditioning.shear_hold_n, conditioning.normal_hold_n,
+                     conditioning.contact_on_n])
+
+
+def _hold_both_ways(kept, widths, alpha):
+    """The force hold run forwards and backwards, averaged: no lag, constant on a hold, as the other filters here."""
+    if widths[:3].max() <= 0.0 or kept.shape[0] == 0:
         return kept
     shape = (kept.shape[0], kept.shape[1] // 3, 3)
     forward, backward = kept.reshape(shape).copy(), kept[::-1].reshape(shape).copy()
-    hold_band(forward, width, alpha, np.ascontiguousarray(forward[0, :, :2]))
-    hold_band(backward, width, alpha, np.ascontiguousarray(backward[0, :, :2]))
-    forward[..., :2] = 0.5 * (forward[..., :2] + backward[::-1, :, :2])
+    hold_band(forward, widths, alpha, np.ascontiguousarray(forward[0]))
+    hold_band(backward, widths, alpha, np.ascontiguousarray(backward[0]))
+    held = widths[:3] > 0.0
+    forward[..., held] = 0.5 * (forward[..., held] + backward[::-1][..., held])
     return forward.reshape(kept.shape)

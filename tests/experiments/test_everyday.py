@@ -18,14 +18,14 @@ def test_press_scene_ramps_holds_and_releases_at_its_rates():
 
 def test_the_crossing_is_log_interpolated_between_rates():
     fractions = [0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0]  # 0.5 reached at 4 N/s, 1.0 at 8 N/s
-    assert everyday._crossing(fractions, 0.5) == pytest.approx(4.0)
-    assert everyday._crossing(fractions, 0.75) == pytest.approx(np.sqrt(4.0 * 8.0))
-    assert np.isnan(everyday._crossing([0.0] * 7, 0.1))
+    assert everyday.crossing_rate(fractions, 0.5) == pytest.approx(4.0)
+    assert everyday.crossing_rate(fractions, 0.75) == pytest.approx(np.sqrt(4.0 * 8.0))
+    assert np.isnan(everyday.crossing_rate([0.0] * 7, 0.1))
 
 
 def test_fires_means_a_spike_in_half_the_trials():
     counts = np.array([[1, 0, 0], [0, 0, 2], [1, 0, 0], [0, 0, 1]])  # 4 trials x 3 afferents
-    assert everyday._fires(counts).tolist() == [True, False, True]
+    assert everyday.fires(counts).tolist() == [True, False, True]
 
 
 def test_a_small_population_gives_fractions_and_thresholds():

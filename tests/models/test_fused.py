@@ -36,7 +36,7 @@ def forces(seed, n=400):
     return np.column_stack([shear * np.cos(angle), shear * np.sin(angle), fz])
 
 
-def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite=None, ids=None):
+def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite=None, ids=None, sensitivity=None):
     """The stage-by-stage path: AF, F_A or stretch, each type's stage (with the trial ``excite``), additive noise."""
     fx, fy, fz = f.T
     drive = np.empty((f.shape[0], len(TYPES)))
@@ -59,7 +59,8 @@ def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite=N
         current[:, cols], _ = current_core(drive[:, cols], FS, kind, params, None, scale[cols],
                                            None if normals is None else normals[cols], cv[cols],
                                            None if excite is None else excite[cols],
-                                           None if ids is None else ids[cols])
+                                           None if ids is None else ids[cols],
+                                           None if sensitivity is None else sensitivity[cols])
     if normals is not None and np.any(sigma > 0):
         current += (normals * (sigma / np.sqrt(1000.0 / FS))[:, None]).T
     return current
@@ -80,8 +81,10 @@ def test_fused_currents_equal_the_stage_by_stage_path(seed, no_shear, physio, no
     key = seed + 1 if noisy else None
     normals = keyed_normals(key, ids, 0, f.shape[0]) if noisy else None
     excite = excitability(key, ids, [params.excite_cv(t) for t in TYPES]) if noisy else None
-    expected = reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite, ids)
-    plan = FusedPipeline(TYPES, NAPS, theta, k, scale, cv, sigma, params, FS, no_shear, 0.1, ids)
+    sensitivity = np.exp(rng.normal(0.0, 0.9, n))  # each unit its own gain and dead zone
+    expected = reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite, ids, sensitivity)
+    plan = FusedPipeline(TYPES, NAPS, theta, k, scale, cv, sigma, params, FS, no_shear, 0.1, ids,
+                         sensitivity=sensitivity)
     state = plan.new_state()
     parts = [plan.currents(f[a:b], state, a > 0, a, key)
              for a, b in ((0, cut), (cut, f.shape[0]))]  # in two chunks: the state carries over

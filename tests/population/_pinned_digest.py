@@ -87,10 +87,15 @@ def pinned_env(cache_dir: str) -> dict:
     return env
 
 
-def run_digests() -> dict:
+#: The fingertip preset before units had a sensitivity: with it the code must still give the digests of then.
+BEFORE_SENSITIVITY = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data",
+                                  "fingertip_before_sensitivity.toml")
+
+
+def run_digests(spec: str = "fingertip") -> dict:
     """SHA-256 digests of the run: its spikes (with their count) and its noise-free currents.
 
-    The fingertip population (rng=0), every third afferent, under
+    The ``spec`` population (rng=0; default the fingertip preset), every third afferent, under
     Birznieks ramps at 30 and 200 degrees: two trials of the direct engine
     with seed 5; and the currents of the ramp at 30 degrees.
     """
@@ -99,7 +104,7 @@ def run_digests() -> dict:
     from ddmm.population import birznieks, sample_population, simulate
     from ddmm.population.simulation import population_currents
 
-    pop = sample_population("fingertip", rng=0).select(np.asarray(AFFERENTS))
+    pop = sample_population(spec, rng=0).select(np.asarray(AFFERENTS))
     ds = simulate(pop, [birznieks(30.0), birznieks(200.0)], engine="direct", seed=5, trials=2, quiet=True)
     spikes = hashlib.sha256()
     for name in ("spike_time", "spike_afferent", "spike_trial", "spike_condition", "spike_count"):
@@ -118,4 +123,4 @@ def dispatch_report() -> dict:
 
 
 if __name__ == "__main__":
-    print(json.dumps({**run_digests(), **dispatch_report()}))
+    print(json.dumps({**run_digests(), "before_sensitivity": run_digests(BEFORE_SENSITIVITY), **dispatch_report()}))

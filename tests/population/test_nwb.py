@@ -78,7 +78,8 @@ def test_metadata_columns_stages_and_forces(exported):
     with pynwb.NWBHDF5IO(path, "r") as io:
         f = io.read()
         units = f.units.to_dataframe()
-        for name in ("afferent_type", "theta_t", "nap", "k", "gain", "x_mm", "y_mm", "region", "frame_deg"):
+        for name in ("afferent_type", "theta_t", "nap", "k", "gain", "sensitivity", "x_mm", "y_mm", "region",
+                     "frame_deg"):
             assert units[name].tolist() == ds[name].values.tolist(), name
         assert "deg" in f.units["theta_t"].description and "millimetres" in f.units["x_mm"].description
         trials = f.trials.to_dataframe()

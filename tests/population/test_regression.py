@@ -56,7 +56,17 @@ from ._pinned_digest import AFFERENTS, pinned_env
 #: mixes were refitted (with the earlier presets the code gave the previous digests, 3bf6cf0d..., 21492,
 #: 0468a5e7...).  Re-recorded when FA-II's high-pass went 120 -> 200 Hz and D 2 -> 0.5 (preset values only,
 #: no code: the earlier presets give the earlier digests, 789a4251..., 21973, 1ceee0e5...).
+#: Re-recorded when units took a per-unit sensitivity (docs/model.md, "Units that differ"): the presets
+#: switched on its spread, FA-I's dead zone went 2 -> 0.75 N/s and the NAP mixes were refitted.  With the
+#: presets of before (`BEFORE`, run from `_pinned_digest.BEFORE_SENSITIVITY`) the code still gives the
+#: earlier digests, and this test holds it to them.
 RECORDED = {
+    "spikes": "f0c0767bf691083fd5d0e83fc8534912db169e401892fd68882cfb12d6c5a788",
+    "n_spikes": 22047,
+    "currents": "139a358d8f7764801ed90f4596db0f5017edf1beaff3076f190f1d283138dbee",
+}
+#: The digests of the presets before per-unit sensitivity (the previous `RECORDED`).
+BEFORE = {
     "spikes": "afb0ae7e5353514748834aa18e0a478269037d3460035bd1672d1a0dd24c38db",
     "n_spikes": 22108,
     "currents": "196b701d1b4e01d2f2dae869385af93c878b3480be1439155f4bcb71a56d098e",
@@ -85,6 +95,7 @@ def test_spikes_and_currents_under_pinned_dispatch_equal_the_recorded_digests():
     assert (run["numba_cpu_name"], run["numba_cpu_features"], run["numpy_dispatch"]) == ("generic", "", [])
     host = f"{platform.machine()} {platform.system()}, {' '.join(platform.libc_ver())}, numpy {np.__version__}"
     assert {key: run[key] for key in RECORDED} == RECORDED, f"recorded on {RECORDED_ON}; this host: {host}"
+    assert run["before_sensitivity"] == BEFORE, "with the presets of before, the code must give the earlier digests"
 
 
 def test_noise_equals_the_recorded_digest():
