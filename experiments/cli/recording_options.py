@@ -10,7 +10,8 @@ _FIELDS = ("time", "fx", "fy", "fz")
 _CSV_ONLY = {"columns": None, "fs": None, "time_scale": 1.0, "negative_fz": "error", "gaps": "error",
              "units": "N", "fz_sign": 1}
 # Conditioning field -> option attribute
-_CONDITIONING = {"noise_n": "sensor_noise", "bandwidth_hz": "bandwidth", "shear_hold_n": "shear_hold"}
+_CONDITIONING = {"noise_n": "sensor_noise", "bandwidth_hz": "bandwidth", "shear_hold_n": "shear_hold",
+                 "normal_hold_n": "normal_hold"}
 
 
 def add_recording_options(p, *, stream: bool = False) -> None:
@@ -42,6 +43,9 @@ def add_recording_options(p, *, stream: bool = False) -> None:
     g.add_argument("--shear-hold", type=float, default=None, metavar="N",
                    help="the shear hold's width in newtons: tangential force moves only beyond +- it "
                         "(default 0.025; 0: off)")
+    g.add_argument("--normal-hold", type=float, default=None, metavar="N",
+                   help="the normal hold's width in newtons: in contact, F_Z moves only beyond +- it "
+                        "(default 0.025; 0: off)")
 
 
 def conditioning_from_args(args):
@@ -50,8 +54,8 @@ def conditioning_from_args(args):
 
     if args.conditioning == "off":
         if any(getattr(args, name) is not None for name in _CONDITIONING.values()):
-            raise ValueError("--sensor-noise, --bandwidth and --shear-hold set the conditioning, which "
-                             "--conditioning off switches off")
+            raise ValueError("--sensor-noise, --bandwidth, --shear-hold and --normal-hold set the conditioning, "
+                             "which --conditioning off switches off")
         return None
     settings = {field: getattr(args, name) for field, name in _CONDITIONING.items() if getattr(args, name) is not None}
     return Conditioning(mode=args.conditioning, **settings)

@@ -59,7 +59,9 @@ def hold_band(x, widths, alpha, held):
     A play operator per axis that re-centres: the output relaxes toward the
     input by ``alpha`` per sample (a first-order low-pass, far slower than
     any afferent cares about) and never strays more than ``widths[a]`` from
-    it (an axis of width 0 passes as it is).  On a hold the output settles
+    it (an axis of width 0 passes as it is).  On the normal axis the width is
+    at most half the force above the contact threshold ``widths[3]``, so the
+    held force crosses that threshold when the input does.  On a hold the output settles
     on the hold's mean and barely moves; on a ramp it moves with the ramp's
     slope, at most the width behind.
     """
@@ -70,8 +72,8 @@ def hold_band(x, widths, alpha, held):
                 if width <= 0.0:
                     continue
                 v = x[i, s, a]
-                if a == 2:
-                    width = min(width, max(v - widths[3], 0.0))
+                if a == 2:  # the normal hold narrows to nothing at contact (widths[3]): contact is not delayed
+                    width = min(width, 0.5 * max(v - widths[3], 0.0))
                 h = held[s, a] + alpha * (v - held[s, a])
                 held[s, a] = min(max(h, v - width), v + width)
                 x[i, s, a] = held[s, a]

@@ -267,7 +267,7 @@ class Conditioner:
             return slow
         sites = slow.shape[1] // 3
         if self._held is None:
-            self._held = np.ascontiguousarray(slow[0].reshape(sites, 3))
+            self._held = np.array(slow[0].reshape(sites, 3))  # a copy: the hold updates it in place
         held = slow.reshape(slow.shape[0], sites, 3).copy()
         hold_band(held, widths, self._alpha, self._held)
         return held.reshape(slow.shape)
@@ -279,7 +279,7 @@ class Conditioner:
         if self._contact is None:
             self._contact = np.zeros(sites, bool)
         if self._held is None:
-            self._held = np.ascontiguousarray(kept[0].reshape(sites, 3))
+            self._held = np.array(kept[0].reshape(sites, 3))  # a copy: the hold updates it in place
         shape = (y.shape[0], sites, 3)
         return gate_hold_contact(y.reshape(shape), slow.reshape(shape), kept.reshape(shape), gate,
                                  widths, self._alpha, self._held, s.contact_on_n, s.contact_off_n,
@@ -360,8 +360,8 @@ def _hold_both_ways(kept, widths, alpha):
         return kept
     shape = (kept.shape[0], kept.shape[1] // 3, 3)
     forward, backward = kept.reshape(shape).copy(), kept[::-1].reshape(shape).copy()
-    hold_band(forward, widths, alpha, np.ascontiguousarray(forward[0]))
-    hold_band(backward, widths, alpha, np.ascontiguousarray(backward[0]))
+    hold_band(forward, widths, alpha, np.array(forward[0]))  # copies: the hold updates its state in place
+    hold_band(backward, widths, alpha, np.array(backward[0]))
     held = widths[:3] > 0.0
     forward[..., held] = 0.5 * (forward[..., held] + backward[::-1][..., held])
     return forward.reshape(kept.shape)

@@ -57,7 +57,9 @@ def test_an_amti_style_file_with_pressing_negative_reads_with_options_alone(tmp_
         from_csv(path)
     scene = from_csv(path, fz_sign=-1)
     settled = scene.fz[1500:2000]  # the hold, after the tracker's overshoot at the ramp's end
-    assert np.allclose(settled, 3.0 - Conditioning().contact_on_n, atol=1e-3) and scene.fs == 1000.0
+    # The normal hold keeps part of the overshoot (at most its width) and re-centres at 0.5 Hz.
+    assert np.allclose(settled, 3.0 - Conditioning().contact_on_n, atol=Conditioning().normal_hold_n)
+    assert scene.fs == 1000.0
 
 
 def test_units_time_scale_and_a_file_without_time(tmp_path):
@@ -142,12 +144,41 @@ def test_the_shear_hold_passes_a_ramp_with_its_slope(mode, lag_n):
     np.testing.assert_allclose(free - held, lag_n, atol=1e-9)
 
 
+@pytest.mark.parametrize("fs_in", [100.0, 250.0])
+def test_the_normal_hold_keeps_a_noisy_pressed_hold_still(fs_in):
+    """20 mN of noise on a 3 N hold: without the hold F_Z wanders at up to about 1 N/s (the most sensitive FA-I
+    fired); with it, at most a quarter as fast (measured 0.15 and 0.04 N/s against 0.72 and 0.34), on the same
+    mean."""
+    _, f = profile(fs_in, 0.02, seed=5)
+    hold = slice(1300, 2000)
+    held = condition_forces(f, fs_in, 1000.0)[0][hold, 2]
+    free = condition_forces(f, fs_in, 1000.0, Conditioning(normal_hold_n=0.0))[0][hold, 2]
+    speed = [np.abs(np.diff(x)).max() * 1000.0 for x in (held, free)]
+    assert speed[0] < 0.25 * speed[1] and speed[1] > 0.3, speed
+    assert abs(held.mean() - free.mean()) < 0.015
+
+
+@pytest.mark.parametrize("mode", ["causal", "zero_phase"])
+def test_the_normal_hold_passes_a_press_with_its_slope_and_contact_as_before(mode):
+    """A 10 N/s press: the same slope in the middle of the ramp, at most the width behind (and the
+    smoothing's overshoot); the onset, where the hold narrows to nothing, is where it was."""
+    t = np.arange(0, 3, 1e-3)
+    f = np.column_stack([np.zeros_like(t), np.zeros_like(t), np.interp(t, [0, 1, 1.4, 3], [0, 0, 4, 4])])
+    held, on_held = condition_forces(f, 1000.0, 1000.0, Conditioning(mode=mode))
+    free, on_free = condition_forces(f, 1000.0, 1000.0, Conditioning(mode=mode, normal_hold_n=0.0))
+    mid = slice(1200, 1350)
+    np.testing.assert_allclose(np.diff(held[mid, 2]), np.diff(free[mid, 2]), atol=1e-4)
+    assert np.all(free[:, 2] - held[:, 2] <= 0.027)
+    np.testing.assert_array_equal(on_held, on_free)
+
+
 @pytest.mark.parametrize(("kwargs", "match"), [
     ({"noise_n": -0.01}, "noise_n must be a finite number >= 0"),
     ({"contact_on_n": 0.01}, "contact_on_n must be a finite number > contact_off_n = 0.015"),
     ({"bandwidth_hz": 0.0}, "bandwidth_hz must be a finite number > 0"),
     ({"mode": "acausal"}, "mode='acausal' is not allowed; allowed: causal, zero_phase"),
     ({"shear_hold_n": -0.01}, "shear_hold_n must be a finite number >= 0 \\(N\\), got -0.01"),
+    ({"normal_hold_n": float("nan")}, "normal_hold_n must be a finite number >= 0 \\(N\\), got nan"),
 ])
 def test_bad_conditioning_is_named(kwargs, match):
     with pytest.raises(ValueError, match=match):
@@ -160,9 +191,12 @@ def test_fast_afferents_are_silent_at_rest_and_in_holds_with_20_mN_of_noise(pop,
     out, _ = condition_forces(f, fs_in, 1000.0)
     r = rates(pop, Scene(*out.T, fs=1000.0, name="plate"))
     for kind in ("RAI", "RAII"):
-        # hold2 is sheared: without the shear hold FA-I fired 1.6 pulses/s there at 100 Hz
         for phase in ("rest", "hold", "hold2", "after"):
-            assert r[kind][phase] == 0.0, (kind, phase, r[kind][phase])
+            # hold2 is sheared: without the shear hold FA-I fired 1.6 pulses/s there at 100 Hz.  Since units have
+            # a sensitivity, the most sensitive FA-I fire there now and then through the shear term (measured
+            # 0.015 pulses/s per afferent at 100 Hz; docs/recordings.md, "Shortfalls"): bounded, not silent.
+            bound = 0.05 if (kind, phase) == ("RAI", "hold2") else 0.0
+            assert r[kind][phase] <= bound, (kind, phase, r[kind][phase])
 
 
 def test_100_hz_and_1_khz_recordings_give_the_same_rates_within_20_percent(pop):
