@@ -176,6 +176,9 @@ def _force_coding(population, context) -> dict:
     return out, data
 
 
+#: Afferents per type in the frequency protocol (FA-II's tuning is shallow near its best: with 20 the median
+#: of units that differ in sensitivity could tie 150 and 200 Hz).
+FREQUENCY_UNITS = 40
 #: Frequencies (Hz) and amplitudes (N) of the vibration protocol.
 FREQUENCIES_HZ = (5.0, 8.0, 16.0, 32.0, 64.0, 100.0, 150.0, 200.0, 250.0, 300.0, 400.0)
 AMPLITUDES_N = tuple(np.geomspace(1e-4, 1.0, 33))
@@ -241,7 +244,7 @@ def _frequency(population, context) -> dict:
         idx = np.flatnonzero(population.afferent_type == kind)
         if idx.size == 0:
             continue
-        pick = np.random.default_rng(context["seed"]).choice(idx, min(idx.size, 20), replace=False)
+        pick = np.random.default_rng(context["seed"]).choice(idx, min(idx.size, FREQUENCY_UNITS), replace=False)
         sub = population.select(np.sort(pick))
         scenes = [vibration_scene(f, a, f"vib_{f:g}_{i}") for f in FREQUENCIES_HZ for i, a in enumerate(AMPLITUDES_N)]
         ds = _run(sub, scenes, context, record=("spikes",))
