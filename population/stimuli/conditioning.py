@@ -26,7 +26,9 @@ it, so a stream and an offline run give the same numbers, bit for bit):
    +-``shear_hold_n`` (tangential) or +-``normal_hold_n`` (normal) around
    their last value (a play operator per axis, `hold_band`), and re-centre
    on the input at 0.5 Hz, so a hold is not left a width short.  The normal
-   hold keeps the slow band's wander (9 mN SD, velocities up to 1 N/s at
+   hold acts before the slow band's smoothing and narrows to half the force
+   above ``contact_on_n``, so contact starts when it would without it; it
+   keeps the slow band's wander (9 mN SD, velocities up to 1 N/s at
    100 Hz and 20 mN of noise) from reaching the most sensitive FA-I, whose
    velocity thresholds reach 0.1-0.2 N/s.  On a sheared hold the slow
    band still carries smoothed noise (at 100 Hz, ten times more per hertz
@@ -349,7 +351,8 @@ def _zero_phase(forces, fs_in, fs_out, conditioning, n_sites):
 
 
 def hold_widths(conditioning: Conditioning) -> np.ndarray:
-    """The force hold's width per axis (x, y, z) in newtons."""
+    """`hold_band`'s settings: the force hold's width per axis (x, y, z) and, last, the contact threshold
+    at which the normal hold narrows to nothing, all in newtons."""
     return np.array([conditioning.shear_hold_n, conditioning.shear_hold_n, conditioning.normal_hold_n,
                      conditioning.contact_on_n])
 
