@@ -10,7 +10,8 @@ from ddmm.models.afferent_types import AFFERENT_TYPES, type_label
 from ddmm.population.analysis.physiology import FREQUENCIES_HZ
 
 __all__ = ["plot_rest", "plot_on_off", "plot_force_coding", "plot_frequency_tuning", "plot_timing",
-           "plot_cycle_histograms", "plot_shear_magnitude", "physiology_figures"]
+           "plot_cycle_histograms", "plot_shear_magnitude", "plot_recruitment", "plot_threshold_spread",
+           "physiology_figures"]
 
 
 def plot_rest(data: dict) -> Figure:
@@ -57,6 +58,8 @@ def plot_force_coding(data: dict) -> Figure:
     a.set_ylabel("SA-I plateau rate (pulses/s)")
     if "rai_loading_rates" in data:
         b.loglog([2, 8, 32], np.maximum(data["rai_loading_rates"], 0.1), "o-", color=TYPE_COLOURS["RAI"])
+        b.set_xticks([2, 8, 32], ["2", "8", "32"])
+        b.xaxis.set_minor_formatter("")
     b.set_xlabel("force rate (N/s)")
     b.set_ylabel("FA-I mean rate while loading (pulses/s)")
     return fig
@@ -163,13 +166,43 @@ def plot_shear_magnitude(data: dict) -> Figure:
     return fig
 
 
+def plot_recruitment(data: dict) -> Figure:
+    """Fraction of FA-I firing while loading to 2 N against the loading rate (log axis)."""
+    fig = Figure(figsize=(4.5, 3.2), layout="constrained")
+    ax = fig.subplots()
+    ax.semilogx(data["rates"], data["fractions"], "o-", color=TYPE_COLOURS["RAI"])
+    ax.set_xticks(data["rates"], [f"{r:g}" for r in data["rates"]])
+    ax.xaxis.set_minor_formatter("")
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlabel("loading rate (N/s)")
+    ax.set_ylabel("FA-I firing while loading")
+    return fig
+
+
+def plot_threshold_spread(data: dict) -> Figure:
+    """Each unit's vibration threshold, sorted (the cumulative distribution), per type; log axis."""
+    fig = Figure(figsize=(4.5, 3.2), layout="constrained")
+    ax = fig.subplots()
+    for kind, entry in data.items():
+        thr = np.sort(entry["thresholds_n"][np.isfinite(entry["thresholds_n"])]) * 1e3
+        if thr.size:
+            ax.semilogx(thr, np.arange(1, thr.size + 1) / thr.size, drawstyle="steps-post", color=TYPE_COLOURS[kind],
+                        label=f"{type_label(kind)} at {entry['frequency_hz']:g} Hz")
+    ax.set_xlabel("vibration threshold (mN, 0.5 N preload)")
+    ax.set_ylabel("fraction of units")
+    ax.legend(fontsize=8, frameon=False)
+    return fig
+
+
 def physiology_figures(data: dict, human_dsi: dict) -> dict:
     """File name -> Figure for every protocol that ran and has a figure."""
     makers = {"rest": ("rest.png", plot_rest), "on_off": ("on_off_psth.png", plot_on_off),
               "force_coding": ("force_coding.png", plot_force_coding),
               "frequency": ("frequency_tuning.png", plot_frequency_tuning), "timing": ("timing.png", plot_timing),
               "phase_locking": ("cycle_histograms.png", plot_cycle_histograms),
-              "shear": ("shear_magnitude.png", plot_shear_magnitude)}
+              "shear": ("shear_magnitude.png", plot_shear_magnitude),
+              "everyday_loading": ("recruitment.png", plot_recruitment),
+              "everyday_threshold": ("threshold_spread.png", plot_threshold_spread)}
     out = {name: make(data[protocol]) for protocol, (name, make) in makers.items() if data.get(protocol)}
     if data.get("direction"):
         out["tuning_dsi.png"] = plot_dsi_histograms(data["direction"]["tuning"], human_dsi)

@@ -2,6 +2,7 @@
 
 import json
 
+import numpy as np
 import pytest
 
 from ddmm.experiments.cli import main
@@ -59,3 +60,15 @@ def test_cycle_histograms_plot_one_panel_per_type():
     assert len(axes) == 2 and "FA-I, 20 Hz" in axes[0].get_title() and "VS 0.50" in axes[0].get_title()
     heights = [p.get_height() for p in axes[0].patches]
     assert max(heights) == pytest.approx(0.75) and sum(heights) == pytest.approx(1.0)
+
+
+def test_everyday_figures_are_written_from_a_small_population(tmp_path):
+    """The recruitment curve and the threshold distributions, from the protocols' own data."""
+    from ddmm.experiments.plots.physiology import physiology_figures, plot_threshold_spread
+
+    data = {"everyday_loading": {"rates": (0.5, 1.0, 2.0), "fractions": [0.1, 0.5, 0.9]},
+            "everyday_threshold": {"RAI": {"frequency_hz": 40.0, "thresholds_n": np.array([1e-3, 4e-3, np.inf])}}}
+    figures = physiology_figures(data, {})
+    assert set(figures) == {"recruitment.png", "threshold_spread.png"}
+    line = plot_threshold_spread(data["everyday_threshold"]).axes[0].lines[0]
+    np.testing.assert_allclose(line.get_xdata(), [1.0, 4.0])  # mN, the unit without a threshold left out
