@@ -57,12 +57,18 @@ def plot_force_coding(data: dict) -> Figure:
     a.set_xlabel("normal force (N)")
     a.set_ylabel("SA-I plateau rate (pulses/s)")
     if "rai_loading_rates" in data:
-        b.loglog([2, 8, 32], np.maximum(data["rai_loading_rates"], 0.1), "o-", color=TYPE_COLOURS["RAI"])
-        b.set_xticks([2, 8, 32], ["2", "8", "32"])
-        b.xaxis.set_minor_formatter("")
+        b.set_yscale("log")
+        _rate_axis(b, [2, 8, 32], np.maximum(data["rai_loading_rates"], 0.1))
     b.set_xlabel("force rate (N/s)")
     b.set_ylabel("FA-I mean rate while loading (pulses/s)")
     return fig
+
+
+def _rate_axis(ax, rates, values) -> None:
+    """FA-I ``values`` against force ``rates`` (N/s) on a log axis labelled at the rates themselves."""
+    ax.semilogx(rates, values, "o-", color=TYPE_COLOURS["RAI"])
+    ax.set_xticks(rates, [f"{r:g}" for r in rates])
+    ax.xaxis.set_minor_formatter("")
 
 
 def plot_frequency_tuning(data: dict) -> Figure:
@@ -170,9 +176,7 @@ def plot_recruitment(data: dict) -> Figure:
     """Fraction of FA-I firing while loading to 2 N against the loading rate (log axis)."""
     fig = Figure(figsize=(4.5, 3.2), layout="constrained")
     ax = fig.subplots()
-    ax.semilogx(data["rates"], data["fractions"], "o-", color=TYPE_COLOURS["RAI"])
-    ax.set_xticks(data["rates"], [f"{r:g}" for r in data["rates"]])
-    ax.xaxis.set_minor_formatter("")
+    _rate_axis(ax, data["rates"], data["fractions"])
     ax.set_ylim(-0.02, 1.02)
     ax.set_xlabel("loading rate (N/s)")
     ax.set_ylabel("FA-I firing while loading")

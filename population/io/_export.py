@@ -11,8 +11,8 @@ import json
 
 import numpy as np
 
-__all__ = ["AFFERENT_FIELDS", "afferent_values", "attrs_json", "check_dataset", "condition_forces", "n_samples",
-           "plain", "site_labels", "spike_order", "stages_of", "trial_grid"]
+__all__ = ["AFFERENT_FIELDS", "OPTIONAL_FIELDS", "afferent_values", "attrs_json", "check_dataset", "condition_forces",
+           "n_samples", "plain", "site_labels", "spike_order", "stages_of", "trial_grid"]
 
 # (coordinate on ``afferent``, unit, description); the afferent id is the unit / spike train's own id.
 AFFERENT_FIELDS = (
@@ -33,9 +33,9 @@ AFFERENT_FIELDS = (
 )
 _LABELS = {"afferent_type", "nap", "region"}
 #: Fields a Dataset of an older version may lack, with the value its run used.
-_OPTIONAL = {"sensitivity": 1.0}
-_REQUIRED = ("afferent", *(name for name, _, _ in AFFERENT_FIELDS if name not in _OPTIONAL), "condition", "duration",
-             "theta_r",
+OPTIONAL_FIELDS = {"sensitivity": 1.0}
+_REQUIRED = ("afferent", *(name for name, _, _ in AFFERENT_FIELDS if name not in OPTIONAL_FIELDS), "condition",
+             "duration", "theta_r",
              "has_theta_r", "trial", "spike_count")
 _EVENTS = ("spike_time", "spike_afferent", "spike_trial", "spike_condition")
 
@@ -74,7 +74,7 @@ def afferent_values(dataset) -> dict:
     out = {"afferent_id": [int(v) for v in dataset["afferent"].values]}
     for name, _, _ in AFFERENT_FIELDS:
         if name not in dataset.variables:  # an older Dataset: the value its run used
-            out[name] = [_OPTIONAL[name]] * len(out["afferent_id"])
+            out[name] = [OPTIONAL_FIELDS[name]] * len(out["afferent_id"])
             continue
         values = dataset[name].values
         out[name] = [str(v) for v in values] if name in _LABELS else [float(v) for v in values]

@@ -215,7 +215,7 @@ def _attach(group, dataset, pairs, offsets_s) -> None:
     """Afferent metadata (read-only Brian2 variables and numpy attributes), ``pairs`` and ``offsets`` on ``group``."""
     n = group.N
     for variable, coord, dtype in _VARIABLES:
-        values = dataset[coord].values if coord in dataset.variables else np.ones(n)  # older: sensitivity 1
+        values = dataset[coord].values if coord in dataset.variables else np.full(n, ex.OPTIONAL_FIELDS[coord])
         group.variables.add_array(variable, size=n, values=np.asarray(values, dtype), dtype=dtype,
                                   constant=True, read_only=True)
     arrays = {label: np.asarray(dataset[label].values).astype(str) for label in _LABELS}
