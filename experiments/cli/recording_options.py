@@ -41,11 +41,11 @@ def add_recording_options(p, *, stream: bool = False) -> None:
                    help="the sensor's noise SD in newtons: the fast band is gated at 4x it (default 0.02; 0: off)")
     g.add_argument("--bandwidth", type=float, default=None, metavar="HZ", help="the sensor's bandwidth in Hz")
     g.add_argument("--shear-hold", type=float, default=None, metavar="N",
-                   help="the shear hold's width in newtons: tangential force moves only beyond +- it "
-                        "(default 0.025; 0: off)")
+                   help="the shear hold's least width in newtons: tangential force moves only beyond +- it, "
+                        "wider on a noisy slow recording (default 0.025; 0: off)")
     g.add_argument("--normal-hold", type=float, default=None, metavar="N",
-                   help="the normal hold's width in newtons: in contact, F_Z moves only beyond +- it "
-                        "(default 0.025; 0: off)")
+                   help="the normal hold's least width in newtons: in contact, F_Z moves only beyond +- it, "
+                        "wider on a noisy slow recording (default 0.025; 0: off)")
 
 
 def conditioning_from_args(args):

@@ -21,21 +21,23 @@ it, so a stream and an offline run give the same numbers, bit for bit):
    the fast band, is removed, on a hold and during a ramp alike; a ramp's
    corners and a vibration larger than the threshold pass, smaller by the
    threshold.
-3. **Force hold** (``shear_hold_n``, ``normal_hold_n`` > 0): the kept band's
-   tangential and normal force move only when they leave a band of
-   +-``shear_hold_n`` (tangential) or +-``normal_hold_n`` (normal) around
-   their last value (a play operator per axis, `hold_band`), and re-centre
-   on the input at 0.5 Hz, so a hold is not left a width short.  The normal
-   hold acts before the slow band's smoothing and narrows to half the force
-   above ``contact_on_n``, so contact starts when it would without it; it
-   keeps the slow band's wander (9 mN SD, velocities up to 1 N/s at
-   100 Hz and 20 mN of noise) from reaching the most sensitive FA-I, whose
-   velocity thresholds reach 0.1-0.2 N/s.  On a sheared hold the slow
-   band still carries smoothed noise (at 100 Hz, ten times more per hertz
-   than at 1 kHz for the same per-sample SD), and the shear term of the
-   presets multiplies it into FA-I's drive; held, the shear drifts at
-   ~0.01 N/s.  A ramp passes with its slope, at most ``shear_hold_n``
-   behind.  The width is the same at every sample rate, so its lag is too.
+3. **Force hold** (``shear_hold_n``, ``normal_hold_n`` > 0; `hold_band`): the
+   kept band's tangential and normal force move only when they leave a band
+   around their last value (a play operator per axis).  The band's width is
+   the setting or five SDs of the noise ``noise_n`` leaves in the band held,
+   whichever is larger (`hold_widths`; at 100 Hz and 20 mN, 41 mN
+   tangential and 52 mN normal: the same per-sample SD puts ten times more
+   noise per hertz into the slow band at 100 Hz than at 1 kHz).  A drag
+   that lasts is a ramp: the band narrows to the setting within ~20 ms, so
+   a ramp passes with its slope, ``shear_hold_n`` behind, at every sample
+   rate.  When the drag ends the output *settles* for 1/``slow_hz`` on
+   the mean of the unfiltered input since then, so a ramp's lag is made up
+   at the ramp's pace and the tracker's overshoot of its end is not kept;
+   then it holds, and nothing creeps (a re-centring at 0.5 Hz, here before,
+   moved a sheared hold at 0.01-0.07 N/s, which the most sensitive FA-I read
+   through the shear term).  The normal hold acts before the slow band's
+   smoothing and narrows to half the force above ``contact_on_n``, so
+   contact starts when it would without it.
 4. **Contact and shear**: contact starts when the gated F_Z rises above
    ``contact_on_n`` and ends when it falls below ``contact_off_n``
    (hysteresis); F_Z becomes ``max(F_Z - contact_on_n, 0)`` (continuous, so a
@@ -66,9 +68,15 @@ CONDITIONING_MODES = ("causal", "zero_phase")
 _ORDER = 2  # the low-passes: 2nd-order Butterworth
 _GATE = 4.0  # the fast band's threshold, in multiples of noise_n: 3 left FA-II 3 pulses/s in a hold
 _SMOOTH = 2.0  # the slow band's smoothing low-pass, in multiples of slow_hz
-# The shear hold re-centres at 0.5 Hz: a step of shear is not left a width short, and the drift it lets
-# through moves at ~0.01 N/s, two hundred times below FA-I's velocity dead zone.
-_RECENTRE_HZ = 0.5
+# The force hold's width is at least this many SDs of the noise in the band it holds (`hold_widths`): at 4 the
+# slow band's excursions still dragged the held shear at 0.4-0.5 N/s in some sheared holds at 100 Hz.
+_HOLD_SDS = 5.0
+# A drag that lasts is a ramp, not noise: the band narrows to its setting with this time constant, so a ramp
+# recorded at 100 Hz lags as one recorded at 1 kHz (at 50 ms SA-I's worst rate ratio was 0.01-0.015 higher).
+_NARROW_S = 0.02
+# `hold_widths` entries that the normal hold (before the smoothing) and the shear hold (after it) each use.
+_NORMAL_ONLY = np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0])
+_SHEAR_ONLY = np.array([1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 0.0])
 
 
 @dataclass(frozen=True)
@@ -92,13 +100,14 @@ class Conditioning:
     shear_deadband_n : float
         Tangential magnitude taken off in contact, newtons.
     shear_hold_n : float
-        Width of the shear hold, newtons: the kept band's tangential force
-        moves only when the input leaves +- this around it (a play
-        operator), so noise on a sheared hold cannot wobble the shear.  0
-        turns it off.  Default 0.025 N (docs/recordings.md gives the
-        measurement).
+        Least width of the shear hold, newtons: the kept band's tangential
+        force moves only when the input leaves +- the width around it (a
+        play operator), so noise on a sheared hold cannot wobble the shear;
+        the width grows to five SDs of the noise the band carries where that
+        is larger, and a ramp trails by this setting.  0 turns it off.
+        Default 0.025 N (docs/recordings.md gives the measurement).
     normal_hold_n : float
-        Width of the same hold on the normal force, newtons (0: off).
+        Least width of the same hold on the normal force, newtons (0: off).
         Default 0.025 N, the shear hold's: a ramp passes at most this far
         behind (2.5 ms at 10 N/s, 12.5 ms at 2 N/s).
     mode : {"causal", "zero_phase"}
@@ -177,12 +186,21 @@ class Conditioner:
     n_sites : int or None
         Chunks are (n, 3), or (n, n_sites, 3) for a sensor array.
 
+    Attributes
+    ----------
+    widths : ndarray, shape (7,)
+        The force hold's widths in newtons (x, y, z), the contact threshold
+        at which the normal hold narrows to nothing, and the widths' floors
+        (x, y, z: the settings), from `hold_widths`.
+
     Examples
     --------
     >>> c = Conditioner(Conditioning(), fs_in=100.0, fs_out=1000.0)
     >>> out, contact = c.push(np.tile([0.0, 0.0, 2.0], (50, 1)))
     >>> out.shape, bool(contact[-1])
     ((500, 3), True)
+    >>> [round(float(w), 3) for w in c.widths[:3]]  # widened: 20 mN of noise at 100 Hz
+    [0.041, 0.041, 0.052]
     """
 
     def __init__(self, conditioning: Conditioning, fs_in: float, fs_out: float, n_sites: int | None = None):
@@ -201,8 +219,30 @@ class Conditioner:
         self._sos_smooth = _lowpass(min(_SMOOTH * conditioning.slow_hz, 0.45 * self.fs_out), self.fs_out)
         self._k = 0  # input samples consumed
         self._zi_rate = self._zi_slow = self._zi_smooth = None
-        self._contact = self._held = None
-        self._alpha = 1.0 - math.exp(-2.0 * math.pi * _RECENTRE_HZ / self.fs_out)
+        self._contact = self._held = self._track = None
+        self._moves = _hold_moves(conditioning, self.fs_out)
+        self.widths = hold_widths(conditioning, *self._band_noise())
+
+    def _band_noise(self):
+        """SD of what the hold sees per newton of white sensor noise: the tracker's band (the normal hold)
+        and that band smoothed (the shear hold), from the filters' responses to one input sample."""
+        from scipy.signal import sosfilt
+
+        ratio = self.fs_out / self.fs_in
+        if self._up:  # one input sample, held over its output samples and filtered at the output rate; each
+            # output sample sums the responses of the inputs 1/ratio apart, hence the division
+            pulse = np.zeros(int(2.0 * self.fs_out) + 1)
+            pulse[:max(round(ratio), 1)] = 1.0
+            rate = sosfilt(self._sos_rate, pulse) / math.sqrt(ratio)
+        else:  # decimated after the anti-aliasing filter: about white at fs_out, of this SD
+            pulse = np.zeros(int(2.0 * self.fs_in) + 1)
+            pulse[0] = 1.0
+            gain = math.sqrt(float(np.sum(sosfilt(self._sos_rate, pulse) ** 2)))
+            rate = np.zeros(int(2.0 * self.fs_out) + 1)
+            rate[0] = gain
+        slow = sosfilt(self._sos_slow, rate)
+        smooth = sosfilt(self._sos_smooth, slow)
+        return math.sqrt(float(np.sum(slow ** 2))), math.sqrt(float(np.sum(smooth ** 2)))
 
     def _shape(self, forces):
         forces = as_finite_array(forces, "forces")
@@ -250,28 +290,27 @@ class Conditioner:
         self._k += x.shape[0]
         if y.shape[0] == 0:
             return self._out(y, np.empty((0, sites), bool))
-        widths = hold_widths(self.settings)
+        widths = self.widths
         if self.settings.noise_n > 0:
             slow = self._filter(self._sos_slow, y, "_zi_slow")
             # The normal hold acts before the smoothing, which rounds its corners: a corner of the held F_Z is
             # a step of its velocity, and unsmoothed it drove FA-II in holds (0.3 pulses/s at 100 Hz, 20 mN).
             # The shear hold stays after it (FA-I's shear term fired more in sheared holds the other way).
-            normal, shear = widths * [0.0, 0.0, 1.0, 1.0], widths * [1.0, 1.0, 0.0, 1.0]
-            kept = self._filter(self._sos_smooth, self._hold(slow, normal), "_zi_smooth")
+            normal, shear = widths * _NORMAL_ONLY, widths * _SHEAR_ONLY
+            kept = self._filter(self._sos_smooth, self._hold(slow, y, normal), "_zi_smooth")
             gate, widths = _GATE * self.settings.noise_n, shear
         else:
             slow, kept, gate = y, y, -1.0
         return self._out(*self._finish(y, slow, kept, gate, widths))
 
-    def _hold(self, slow, widths):
+    def _hold(self, slow, y, widths):
         """The force hold (`hold_band`) on a copy of the tracker's slow band, its state carried over."""
         if widths[:3].max() <= 0.0:
             return slow
         sites = slow.shape[1] // 3
-        if self._held is None:
-            self._held = np.array(slow[0].reshape(sites, 3))  # a copy: the hold updates it in place
+        self._start_hold(slow[0], sites)
         held = slow.reshape(slow.shape[0], sites, 3).copy()
-        hold_band(held, widths, self._alpha, self._held)
+        hold_band(held, y.reshape(held.shape), widths, self._moves, self._held, self._track)
         return held.reshape(slow.shape)
 
     def _finish(self, y, slow, kept, gate, widths):
@@ -280,12 +319,17 @@ class Conditioner:
         s, sites = self.settings, y.shape[1] // 3
         if self._contact is None:
             self._contact = np.zeros(sites, bool)
-        if self._held is None:
-            self._held = np.array(kept[0].reshape(sites, 3))  # a copy: the hold updates it in place
+        self._start_hold(kept[0], sites)
         shape = (y.shape[0], sites, 3)
         return gate_hold_contact(y.reshape(shape), slow.reshape(shape), kept.reshape(shape), gate,
-                                 widths, self._alpha, self._held, s.contact_on_n, s.contact_off_n,
+                                 widths, self._moves, self._held, self._track, s.contact_on_n, s.contact_off_n,
                                  s.shear_deadband_n, self._contact)
+
+    def _start_hold(self, first, sites):
+        """The hold's state, from the first sample it sees (a copy: the hold updates it in place)."""
+        if self._held is None:
+            self._held = np.array(first.reshape(sites, 3))
+            self._track = _start_track(sites)
 
     def _out(self, y, contact):
         if self.n_sites is None:
@@ -339,32 +383,61 @@ def _zero_phase(forces, fs_in, fs_out, conditioning, n_sites):
     if conditioning.bandwidth_hz is not None and conditioning.bandwidth_hz < 0.45 * fs_out:
         y = sosfiltfilt(_lowpass(conditioning.bandwidth_hz, fs_out), y, axis=0, padlen=padlen)
     slow, kept, gate = y, y, -1.0
-    widths = hold_widths(conditioning)
+    widths, moves = causal.widths, causal._moves  # the causal widths: the two-way filters' noise is no larger
     if conditioning.noise_n > 0:
         slow = sosfiltfilt(causal._sos_slow, y, axis=0, padlen=padlen)
-        held = _hold_both_ways(np.ascontiguousarray(slow), widths * [0.0, 0.0, 1.0, 1.0], causal._alpha)
+        held = _hold_both_ways(np.ascontiguousarray(slow), y, widths * _NORMAL_ONLY, moves)
         kept, gate = sosfiltfilt(causal._sos_smooth, held, axis=0, padlen=padlen), _GATE * conditioning.noise_n
-        widths = widths * [1.0, 1.0, 0.0, 1.0]
-    kept = _hold_both_ways(np.ascontiguousarray(kept), widths, causal._alpha)
+        widths = widths * _SHEAR_ONLY
+    kept = _hold_both_ways(np.ascontiguousarray(kept), y, widths, moves)
     return causal._out(*causal._finish(np.ascontiguousarray(y), np.ascontiguousarray(slow), kept, gate,
-                                       np.zeros(4)))
+                                       np.zeros(7)))
 
 
-def hold_widths(conditioning: Conditioning) -> np.ndarray:
-    """`hold_band`'s settings: the force hold's width per axis (x, y, z) and, last, the contact threshold
-    at which the normal hold narrows to nothing, all in newtons."""
-    return np.array([conditioning.shear_hold_n, conditioning.shear_hold_n, conditioning.normal_hold_n,
-                     conditioning.contact_on_n])
+def hold_widths(conditioning: Conditioning, tracker_sd: float = 0.0, smooth_sd: float = 0.0) -> np.ndarray:
+    """`hold_band`'s widths: the force hold's per axis (x, y, z), the contact threshold at which the normal
+    hold narrows to nothing, and the floors (x, y, z) to which a lasting drag narrows it, all in newtons.
+
+    An axis's width is its setting or `_HOLD_SDS` times the SD that the sensor noise (``noise_n``) leaves
+    in the band the hold sees, whichever is larger: ``smooth_sd`` (shear) and ``tracker_sd`` (normal) are
+    those SDs per newton of white noise at the recording's rate.  At 100 Hz the slow band carries ten
+    times more noise per hertz than at 1 kHz for the same per-sample SD, and a fixed width let its rare
+    excursions drag the held force at up to 0.7 N/s.
+    """
+    noise = _HOLD_SDS * conditioning.noise_n
+    shear = max(conditioning.shear_hold_n, noise * smooth_sd) if conditioning.shear_hold_n > 0 else 0.0
+    normal = max(conditioning.normal_hold_n, noise * tracker_sd) if conditioning.normal_hold_n > 0 else 0.0
+    floors = [min(conditioning.shear_hold_n, shear), min(conditioning.shear_hold_n, shear),
+              min(conditioning.normal_hold_n, normal)]
+    return np.array([shear, shear, normal, conditioning.contact_on_n, *floors])
 
 
-def _hold_both_ways(kept, widths, alpha):
+def _hold_moves(conditioning: Conditioning, fs: float) -> np.ndarray:
+    """`hold_band`'s rates at ``fs`` Hz: the settling's approach per sample (a fraction: the slow band's
+    smoothing frequency, so a ramp's end is rounded as that smoothing rounds it), the settling's length in
+    samples (one period of the tracker's bandwidth, by which its overshoot of a ramp's end has decayed) and
+    the band's narrowing per dragged sample (a fraction: time constant `_NARROW_S`)."""
+    return np.array([1.0 - math.exp(-2.0 * math.pi * _SMOOTH * conditioning.slow_hz / fs),
+                     fs / conditioning.slow_hz, 1.0 - math.exp(-1.0 / (_NARROW_S * fs))])
+
+
+def _start_track(sites: int) -> np.ndarray:
+    """`hold_band`'s initial ``track`` (sites, 3, 4): settling, at the approach's own pace, so the hold starts
+    on the mean of its first 1/slow_hz seconds of input rather than on the first (noisy) sample."""
+    track = np.zeros((sites, 3, 4))
+    track[:, :, 0] = np.inf
+    return track
+
+
+def _hold_both_ways(kept, y, widths, moves):
     """The force hold run forwards and backwards, averaged: no lag, constant on a hold, as the other filters here."""
     if widths[:3].max() <= 0.0 or kept.shape[0] == 0:
         return kept
     shape = (kept.shape[0], kept.shape[1] // 3, 3)
     forward, backward = kept.reshape(shape).copy(), kept[::-1].reshape(shape).copy()
-    hold_band(forward, widths, alpha, np.array(forward[0]))  # copies: the hold updates its state in place
-    hold_band(backward, widths, alpha, np.array(backward[0]))
+    ref = np.ascontiguousarray(y).reshape(shape)
+    hold_band(forward, ref, widths, moves, np.array(forward[0]), _start_track(shape[1]))  # copies: updated in place
+    hold_band(backward, np.ascontiguousarray(ref[::-1]), widths, moves, np.array(backward[0]), _start_track(shape[1]))
     held = widths[:3] > 0.0
     forward[..., held] = 0.5 * (forward[..., held] + backward[::-1][..., held])
     return forward.reshape(kept.shape)

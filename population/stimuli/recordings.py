@@ -194,8 +194,8 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
     >>> _ = path.write_text("Time,Fx,Fy,Fz\\n" + "".join(f"{k / 1000},0,0,{-min(k / 100, 2.0)}\\n"
     ...                                                   for k in range(1000)))
     >>> scene = from_csv(path, fz_sign=-1)
-    >>> scene.fs, round(float(scene.fz[-1]), 2)  # 2 N less the contact threshold, within the normal hold
-    (1000.0, 1.98)
+    >>> scene.fs, round(float(scene.fz[-1]), 2)  # 2 N less the contact threshold (30 mN)
+    (1000.0, 1.97)
     """
     _check_options(fs, units, fz_sign, negative_fz, gaps, conditioning)
     mapping = _mapping(columns, recorded_fs)
