@@ -20,7 +20,8 @@ __all__ = ["mix_forces", "mixing_matrix"]
 _COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA, _TONIC, _DEAD = range(14)
 _N_AFF_ROWS = 14
 # Rows of the per-group float and integer tables.
-_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _NEGATIVE, _DYN, _ALPHA_DYN, _FALL, _SHEAR_G, _OPP_SHEAR = range(11)
+(_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _NEGATIVE, _DYN, _ALPHA_DYN, _FALL, _SHEAR_G, _OPP_SHEAR,
+ _DEPTH) = range(12)
 _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = range(9)
 # Rows of the state after the 2 * n_sections filter rows.
 _OFFSET, _Y1, _Y2, _SLOW, _SMOOTH, _DYNC = range(6)
@@ -42,22 +43,22 @@ def _shear(fx, fy, two_fth):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _sheared(p, fz, mag, w, tuned, smooth_reading, outside_value, f_th, shear_g, opp_s):
+def _sheared(p, fz, mag, w, tuned, smooth_reading, outside_value, f_th, shear_g, opp_s, depth):
     """F_A of a pressure afferent plus its shear-magnitude term (`attenuation.shear_drive`), from its profile
-    AF ``p`` (1 when untuned), in the per-stage path's order of operations."""
+    AF ``p`` (1 when untuned), in the per-stage path's order of operations; ``depth`` as
+    `attenuation.attenuated_force`."""
     if not tuned:
         fa = fz
-    elif smooth_reading:
-        fa = (((p - 1.0) * w) + 1.0) * fz
     else:
-        fa = (p if mag > f_th else outside_value) * fz
+        a = (((p - 1.0) * w) + 1.0) if smooth_reading else (p if mag > f_th else outside_value)
+        fa = (a if depth == 1.0 else 1.0 + depth * (a - 1.0)) * fz
     x = fa + shear_g * (mag * (p - opp_s * (1.0 - p)))
     return x if x > 0.0 else 0.0  # `shear_drive`'s floor
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value, f_th,
-                  opponent, normal, af, cached, shear_g, opp_s):
+                  opponent, normal, af, cached, shear_g, opp_s, depth):
     """The drive (newtons) of a group that feels one force, in passes: the profile AF where needed
     (`attenuation.profile_value`), then F_A = AF F_Z under the no-shear reading, or SA-II's stretch
     (`stretch_drive`).  As one loop, the profile's branches kept the whole body scalar, 3-4x slower.
@@ -84,7 +85,7 @@ def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_r
                 f[j] = f[j] + normal * fz
     elif shear_g != 0.0:
         for j in range(f.size):
-            f[j] = _sheared(f[j], fz, mag, w, tuned, smooth_reading, outside_value, f_th, shear_g, opp_s)
+            f[j] = _sheared(f[j], fz, mag, w, tuned, smooth_reading, outside_value, f_th, shear_g, opp_s, depth)
     elif smooth_reading:
         for j in range(f.size):
             f[j] = (((f[j] - 1.0) * w) + 1.0) * fz
@@ -104,7 +105,7 @@ def mixing_matrix(indptr, indices, coeff, n_sites: int) -> np.ndarray:
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_reading, outside_value, f_th, opponent,
-                 normal, mags, wts, shear_g, opp_s):
+                 normal, mags, wts, shear_g, opp_s, depth):
     """`_shared_drive` for afferents that each feel their own force ``local`` (3, n_afferents), in passes:
     shear magnitude and weight, the profile where needed, then the drive (the same arithmetic)."""
     for j in range(lo, hi):
@@ -129,7 +130,7 @@ def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_readin
     elif shear_g != 0.0:
         for j in range(lo, hi):
             f[j] = _sheared(f[j], local[2, j], mags[j], wts[j], tuned, smooth_reading, outside_value, f_th, shear_g,
-                            opp_s)
+                            opp_s, depth)
     elif not tuned:
         for j in range(lo, hi):
             f[j] = local[2, j]

@@ -290,8 +290,8 @@ def af_core(ux, uy, cos_t, sin_t, k, params, tip) -> np.ndarray:
     return _af_kernel(ux, uy, np.ravel(cos_t).astype(float), np.ravel(sin_t).astype(float), *per)
 
 
-def attenuated_force(fz, af) -> np.ndarray:
-    """Attenuated force F_A = AF * F_Z in newtons (eq. 18).
+def attenuated_force(fz, af, depth: float = 1.0) -> np.ndarray:
+    """Attenuated force F_A = AF * F_Z in newtons (eq. 18), or ``(1 + depth (AF - 1)) F_Z``.
 
     Parameters
     ----------
@@ -299,12 +299,22 @@ def attenuated_force(fz, af) -> np.ndarray:
         Normal force in newtons.
     af : array_like, shape (n_samples, n_afferents)
         Attenuation factors from `attenuation_factor`.
+    depth : float
+        How deep the attenuation goes, in [0, 1] (``CurrentParams.depth_<type>``;
+        1, the default, is eq. 18; 0 passes F_Z whatever the direction).
 
     Examples
     --------
     >>> attenuated_force([2.0], [[0.5, 1.0]]).tolist()
     [[1.0, 2.0]]
+    >>> attenuated_force([2.0], [[0.5, 1.0]], depth=0.5).tolist()
+    [[1.5, 2.0]]
     """
     fz = np.asarray(fz, dtype=float)
-    return np.asarray(af, dtype=float) * fz[:, None]
+    if isinstance(depth, bool) or not isinstance(depth, (int, float)) or not 0.0 <= depth <= 1.0:
+        raise ValueError(f"depth must be a number in [0, 1] (1: eq. 18), got {depth!r}")
+    af = np.asarray(af, dtype=float)
+    if depth != 1.0:  # the `_fused_drive._sheared` arithmetic, in its order
+        af = 1.0 + depth * (af - 1.0)
+    return af * fz[:, None]
 

@@ -138,6 +138,12 @@ class CurrentParams:
         Ours: how much shear against the preferred direction lowers the
         type's shear term (dimensionless, as ``opponent_saii``; 0: the term
         is AF F_S, never negative).
+    depth_sai, depth_rai, depth_raii : float
+        Ours: how deep the NAP's attenuation of the normal force goes, in
+        [0, 1] (dimensionless; 1: the paper's ``F_A = AF F_Z``, eq. 18):
+        ``F_A = (1 + depth (AF - 1)) F_Z``, so at 0.5 the normal force keeps
+        at least half its drive in every direction and the direction is
+        carried more by the shear term (docs/model.md, "What changed").
     i_max_sai, i_max_rai, i_max_raii, i_max_saii : float or None
         Ours: bound of the saturating transducer in mV/ms,
         ``I = i_max * tanh(d / i_max)``; None: no bound.
@@ -197,6 +203,9 @@ class CurrentParams:
     opponent_shear_sai: float = 0.0
     opponent_shear_rai: float = 0.0
     opponent_shear_raii: float = 0.0
+    depth_sai: float = 1.0
+    depth_rai: float = 1.0
+    depth_raii: float = 1.0
     i_max_sai: float | None = None
     i_max_rai: float | None = None
     i_max_raii: float | None = None
@@ -238,11 +247,10 @@ class CurrentParams:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {shown(value)}")
-        for name in ("negative_weight_rai", "negative_weight_raii"):
+        for name in ("negative_weight_rai", "negative_weight_raii", "depth_sai", "depth_rai", "depth_raii"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
-                raise ValueError(f"{name} must be a number in [0, 1] (1: the paper's absolute value), "
-                                 f"got {shown(value)}")
+                raise ValueError(f"{name} must be a number in [0, 1] (1: the paper's form), got {shown(value)}")
 
     def _own(self, prefix: str, afferent_type: str, suffix: str = "", default=None):
         """The per-type field ``<prefix>_<type><suffix>`` (e.g. ``i_max_raii``), or ``default`` if it has none."""
@@ -283,7 +291,8 @@ class CurrentParams:
                             self._own("tau_dynamic", afferent_type, "_s", 1.0),
                             self._own("bias_cv", afferent_type, default=0.0), self._own("fall", afferent_type, default=0.0),
                             self._own("shear", afferent_type, default=0.0),
-                            self._own("opponent_shear", afferent_type, default=0.0))
+                            self._own("opponent_shear", afferent_type, default=0.0),
+                            float(self._own("depth", afferent_type, default=1.0)))
 
 
     def stage(self, afferent_type: str) -> TypeCurrentParams:
@@ -333,6 +342,8 @@ class TypeCurrentParams:
         Gain of the shear-magnitude term added to F_A (dimensionless; 0: none).
     opponent_shear : float
         How much shear against the preferred direction lowers that term (dimensionless).
+    depth : float
+        Depth of the NAP's attenuation of the normal force, in [0, 1] (1: the paper's F_A).
     """
 
     afferent_type: str
@@ -355,6 +366,7 @@ class TypeCurrentParams:
     fall: float = 0.0
     shear: float = 0.0
     opponent_shear: float = 0.0
+    depth: float = 1.0
 
     @property
     def signed(self) -> bool:

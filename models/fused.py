@@ -43,6 +43,7 @@ from ddmm.models._fused_drive import (
     _COS,
     _CV,
     _DEAD,
+    _DEPTH,
     _DYN,
     _DYNC,
     _FALL,
@@ -168,17 +169,17 @@ def _front_range(forces, sites, weights, mixed, key, noisy_any, ids, sample0, st
             if lo >= hi:
                 continue
             tuned, stretch = grp_i[_TUNED_G, g] != 0, grp_i[_SIGNED, g] != 0
-            shear_g, opp_s = grp_f[_SHEAR_G, g], grp_f[_OPP_SHEAR, g]
+            shear_g, opp_s, depth = grp_f[_SHEAR_G, g], grp_f[_OPP_SHEAR, g], grp_f[_DEPTH, g]
             if mixed:
                 _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_reading, outside_value,
-                             f_th, opponent, normal, mags, wts, shear_g, opp_s)
+                             f_th, opponent, normal, mags, wts, shear_g, opp_s, depth)
             elif not tuned and not stretch and shear_g == 0.0:
                 f[lo:hi] = fz  # untuned pressure afferents: F_A = F_Z
             else:
                 profiled = tuned and mag > 0.0 and (smooth_reading or stretch or shear_g != 0.0 or mag > f_th)
                 cached = profiled and ux == af_ux[g] and uy == af_uy[g]
                 _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_reading, outside_value,
-                              f_th, opponent, normal, af, cached, shear_g, opp_s)
+                              f_th, opponent, normal, af, cached, shear_g, opp_s, depth)
                 if profiled:
                     af_ux[g], af_uy[g] = ux, uy
             if i == 0 and not started and grp_i[_PLAIN, g] == 0:
@@ -361,14 +362,14 @@ class FusedPipeline:
 
     def _group_tables(self, spans, consts, noise_cv, tuned):
         n_groups, n_sec = len(spans), max([sos.shape[0] for _, sos, _, _ in consts] + [1])
-        grp_f, grp_i = np.zeros((11, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
+        grp_f, grp_i = np.zeros((12, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
         sos_all = np.zeros((n_groups, n_sec, 6))
         for g, ((a, b), (st, sos, alpha_adapt, alpha_smooth)) in enumerate(zip(spans, consts)):
             sos_all[g, :sos.shape[0]] = sos
             plain = st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
             grp_f[:, g] = [st.adapt, alpha_adapt, st.threshold, alpha_smooth, st.bias, st.negative_weight, st.dynamic,
                            float(-np.expm1(-1.0 / (self.fs * st.tau_dynamic_s))), st.fall,  # `currents._alpha`
-                           st.shear, st.opponent_shear]
+                           st.shear, st.opponent_shear, st.depth]
             grp_i[:, g] = [sos.shape[0], st.derivative, st.signed, plain, np.any(noise_cv[a:b] > 0),
                            st.tau_s is not None, tuned[a], a, b]
         return grp_f, grp_i, sos_all

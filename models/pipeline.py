@@ -91,6 +91,8 @@ def compute_currents(
     for kind in ("SAI", "RAI", "RAII"):  # the presets' shear-magnitude term (0 by default: F_A as it is)
         cols = np.flatnonzero(types == kind)
         stage = current_params.for_type(kind)
+        if cols.size and stage.depth != 1.0:
+            drive[:, cols] = attenuated_force(fz, af[:, cols], stage.depth)
         if cols.size and stage.shear != 0.0:
             raw = profile_factor(fx, fy, theta[cols], profile, np.broadcast_to(k, theta.shape)[cols])
             drive[:, cols] = shear_drive(drive[:, cols], fx, fy, raw, stage.shear, stage.opponent_shear)

@@ -17,7 +17,8 @@ from ddmm.population import load_spec
 FS = 1000.0
 #: The fingertip's stage with the shear-magnitude term on, so every branch is compared.
 PHYSIO = dataclasses.replace(load_spec("fingertip").current, shear_sai=0.5, shear_rai=4.0, shear_raii=1.0,
-                             opponent_shear_sai=1.0, opponent_shear_rai=0.5, opponent_shear_raii=0.25)
+                             opponent_shear_sai=1.0, opponent_shear_rai=0.5, opponent_shear_raii=0.25, depth_sai=0.5,
+                             depth_rai=0.7)
 #: The presets with a half-wave FA-II drive too (their FA-I drive already is: negative_weight_rai < 1).
 HALF_WAVE = dataclasses.replace(PHYSIO, negative_weight_raii=0.0)
 #: Afferents in runs of one type (as the encoder orders them), tuned and untuned in each.
@@ -47,8 +48,8 @@ def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite=N
         elif nap == UNTUNED:
             drive[:, j] = fz
         else:
-            drive[:, j] = attenuated_force(fz, attenuation_factor(fx, fy, theta[j], nap, k[j],
-                                                                  no_shear=no_shear))[:, 0]
+            drive[:, j] = attenuated_force(fz, attenuation_factor(fx, fy, theta[j], nap, k[j], no_shear=no_shear),
+                                           params.for_type(kind).depth)[:, 0]
         if kind != "SAII":  # the presets' shear-magnitude term (a no-op at the paper's defaults)
             raw = profile_factor(fx, fy, theta[j], nap, k[j])
             drive[:, [j]] = shear_drive(drive[:, [j]], fx, fy, raw, params.for_type(kind).shear,

@@ -5,7 +5,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ddmm.models.attenuation import shear_drive
+from ddmm.models.attenuation import attenuated_force, shear_drive
 from ddmm.models.currents import CurrentParams
 from ddmm.models.pipeline import compute_currents
 from ddmm.population import load_spec, sample_population
@@ -71,3 +71,23 @@ def test_plan_keeps_afferents_the_shear_term_drives_without_normal_force():
     assert planned.spike_time.size > 0
     np.testing.assert_array_equal(planned.spike_time.values, brute.spike_time.values)
     np.testing.assert_array_equal(planned.spike_afferent.values, brute.spike_afferent.values)
+
+
+def test_the_attenuation_depth_keeps_part_of_the_normal_force_in_every_direction():
+    """``depth_<type>``: F_A = (1 + depth (AF - 1)) F_Z; 1 is the paper's F_A = AF F_Z, bit for bit."""
+    fx, fy, fz = _held(1.0, 270.0)  # against a selective SA-I tuned to 90 deg: AF = 0.2
+    paper = CurrentParams()
+
+    def drive(depth):
+        return compute_currents(fx, fy, fz, fs=1000.0, afferent_type="SAI", profile="selective", theta_t=[90.0],
+                                no_shear="smooth", current_params=replace(paper, depth_sai=depth))[1000:, 0].mean()
+
+    np.testing.assert_array_equal(
+        compute_currents(fx, fy, fz, fs=1000.0, afferent_type="SAI", profile="selective", theta_t=[90.0],
+                         no_shear="smooth", current_params=replace(paper, depth_sai=1.0)),
+        compute_currents(fx, fy, fz, fs=1000.0, afferent_type="SAI", profile="selective", theta_t=[90.0],
+                         no_shear="smooth", current_params=paper))
+    assert drive(1.0) < drive(0.5) < drive(0.0)
+    np.testing.assert_allclose(attenuated_force([2.0], [[0.2]], 0.5), [[1.2]])
+    with pytest.raises(ValueError, match=r"depth_sai must be a number in \[0, 1\] \(1: the paper's form\), got 1.5"):
+        CurrentParams(depth_sai=1.5)
