@@ -1,0 +1,40 @@
+"""The tilted-load and SA-I peak protocols (`ddmm.experiments.validation.tilt`): scenes and a small run."""
+
+import numpy as np
+import pytest
+
+from ddmm.experiments.validation.tilt import peak_table, tilt_scene, tilt_table
+from ddmm.population import sample_population
+
+
+def test_a_tilt_scene_tilts_the_resultant_toward_its_direction():
+    scene = tilt_scene(4.0, 20.0, 135.0)
+    hold = slice(500, None)
+    tangential = np.hypot(scene.fx[hold], scene.fy[hold])
+    np.testing.assert_allclose(np.degrees(np.arctan2(tangential, scene.fz[hold])), 20.0)
+    np.testing.assert_allclose(np.degrees(np.arctan2(scene.fy[hold], scene.fx[hold])), 135.0)
+    assert scene.fz[99] == 0.0 and scene.fz[150] == pytest.approx(1.0, abs=0.03)  # 20 N/s from 0.1 s
+
+
+@pytest.fixture(scope="module")
+def few():
+    pop = sample_population("fingertip", rng=7)
+    kinds = np.asarray(pop.afferent_type)
+    keep = np.concatenate([np.flatnonzero(kinds == k)[:n] for k, n in (("SAI", 30), ("RAI", 30), ("SAII", 12))])
+    return pop.select(np.sort(keep))
+
+
+def test_tangential_load_adds_to_sa_ii_and_the_table_is_fractions(few):
+    table = tilt_table(few, 4.0, directions=6, seed=7)
+    assert set(table) == {"SAI", "SAII", "RAI"}
+    for row in table.values():
+        assert all(0.0 <= row[k] <= 1.0 for k in ("above_10pct", "halved_worst", "silenced_worst"))
+    assert table["SAII"]["median_best_over_normal"] > 1.2  # stretch drives SA-II: 1.43 on the whole fingertip
+
+
+def test_sa_i_plateaus_code_force_not_loading_rate(few):
+    table = peak_table(few, rates_n_s=(4.0, 32.0), seed=7)
+    plateau = {key: row["median_plateau"] for key, row in table.items()}
+    assert plateau["4 N at 4 N/s"] > plateau["2 N at 4 N/s"]
+    assert plateau["2 N at 32 N/s"] == pytest.approx(plateau["2 N at 4 N/s"], rel=0.2)
+    assert table["2 N at 32 N/s"]["median_peak"] > table["2 N at 4 N/s"]["median_peak"]
