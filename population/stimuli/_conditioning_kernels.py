@@ -138,9 +138,9 @@ def gate_hold_contact(y, slow, smooth, gate, widths, moves, held, track, on, off
     ``y`` is the resampled recording (n, sites, 3); ``slow`` and ``smooth``
     are its tracker's slow band and that band smoothed (ignored when
     ``gate`` is negative: no gate, the hold acts on ``y``; ``widths`` (per
-    axis), ``moves``, ``held`` and ``speed`` are `hold_band`'s).  ``held``,
-    ``speed`` and ``state`` (sites, bool contact) carry over between chunks.  Returns
-    the conditioned forces (n, sites, 3) and the contact (n, sites).
+    axis), ``moves``, ``held`` and ``track`` are `hold_band`'s).  ``held``,
+    ``track`` and ``state`` (sites, bool contact) carry over between chunks.
+    Returns the conditioned forces (n, sites, 3) and the contact (n, sites).
     """
     n, sites = y.shape[0], y.shape[1]
     kept = smooth.copy() if gate >= 0.0 else y.copy()
