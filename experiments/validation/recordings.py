@@ -24,7 +24,7 @@ import warnings
 
 import numpy as np
 
-__all__ = ["PROFILES", "PHASES", "recording", "phase_rates", "run_check"]
+__all__ = ["PROFILES", "PHASES", "recording", "phase_rates", "run_check", "hold_sweep"]
 
 #: name -> (knot times, fx, fy, fz), role
 PROFILES = {
@@ -97,6 +97,29 @@ def run_check(noise_levels=(0.0, 0.005, 0.01, 0.02), density_n: float = 0.02, se
     return result
 
 
+def hold_sweep(populations=range(5), noise_seeds: int = 5, rates_hz=(100.0, 250.0), noise_n: float = 0.02) -> dict:
+    """FA-I and FA-II at rest and in the holds of the two first profiles, over populations, noise seeds and the
+    slow rates: per type, how many phase-rates are above 0 and the largest (pulses/s per afferent).
+
+    The force hold's widths and settling were chosen looking at this sweep: **constrained**.
+    """
+    from ddmm.population import sample_population
+    from ddmm.population.stimuli.conditioning import Conditioning
+
+    quiet = {"RAI": [], "RAII": []}
+    for ps in populations:
+        pop = sample_population("fingertip", rng=ps)
+        for profile in ("press-push-lift", "variant"):
+            for fs in rates_hz:
+                for k in range(noise_seeds):
+                    rates = phase_rates(pop, recording(profile, fs, noise_n, k + 10 * ps), fs, profile,
+                                        Conditioning())
+                    for kind, values in quiet.items():
+                        values += [rates[kind][phase] for phase in ("rest", "hold", "hold2", "after")]
+    return {kind: {"phase_rates": len(v), "above_0": int(np.sum(np.array(v) > 0)), "max": float(max(v))}
+            for kind, v in quiet.items()}
+
+
 def _worst(rates) -> dict:
     """Per type: the largest max/min across rates of any phase whose largest rate is >= 2 imp/s (FA-II: only
     rates that carry its band)."""
@@ -123,7 +146,14 @@ if __name__ == "__main__":  # pragma: no cover - a measurement, printed
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--holds", action="store_true",
+                        help="FA-I and FA-II in rest and holds: populations 0-4 x 5 noise seeds x 100, 250 Hz, 20 mN")
     args = parser.parse_args()
+    if args.holds:
+        for kind, row in hold_sweep().items():
+            print(f"{kind} at rest and in holds (constrained): {row['above_0']} of {row['phase_rates']} phase-rates "
+                  f"above 0, largest {row['max']:.3f} pulses/s per afferent")
+        raise SystemExit(0)
     out = run_check(seed=args.seed)
     if args.json:
         print(json.dumps({k: {**v, "rates": {str(fs): r for fs, r in v["rates"].items()}} for k, v in out.items()}))
