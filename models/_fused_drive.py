@@ -52,6 +52,8 @@ def _sheared(p, fz, mag, w, tuned, smooth_reading, outside_value, f_th, shear_g,
     else:
         a = (((p - 1.0) * w) + 1.0) if smooth_reading else (p if mag > f_th else outside_value)
         fa = (a if depth == 1.0 else 1.0 + depth * (a - 1.0)) * fz
+    if shear_g == 0.0:
+        return fa  # `shear_drive` with no term: F_A as it is
     x = fa + shear_g * (mag * (p - opp_s * (1.0 - p)))
     return x if x > 0.0 else 0.0  # `shear_drive`'s floor
 
@@ -83,7 +85,7 @@ def _shared_drive(f, lo, hi, aff_f, tuned, stretch, fz, mag, ux, uy, w, smooth_r
         if normal != 0.0:  # SA-II's normal-force drive (`stretch_drive`)
             for j in range(f.size):
                 f[j] = f[j] + normal * fz
-    elif shear_g != 0.0:
+    elif shear_g != 0.0 or depth != 1.0:
         for j in range(f.size):
             f[j] = _sheared(f[j], fz, mag, w, tuned, smooth_reading, outside_value, f_th, shear_g, opp_s, depth)
     elif smooth_reading:
@@ -127,7 +129,7 @@ def _local_drive(f, lo, hi, local, aff_f, tuned, stretch, two_fth, smooth_readin
         if normal != 0.0:
             for j in range(lo, hi):
                 f[j] = f[j] + normal * local[2, j]
-    elif shear_g != 0.0:
+    elif shear_g != 0.0 or depth != 1.0:
         for j in range(lo, hi):
             f[j] = _sheared(f[j], local[2, j], mags[j], wts[j], tuned, smooth_reading, outside_value, f_th, shear_g,
                             opp_s, depth)

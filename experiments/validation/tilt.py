@@ -53,33 +53,32 @@ def tilt_scene(normal_n: float, tilt_deg: float, direction_deg: float, rate_n_s:
                  name=f"tilt {tilt_deg:g} deg toward {direction_deg:g} deg")
 
 
-def _counts(population, scene, seed, window):
+def _simulate(population, scene, seed):
     from ddmm.population import simulate
 
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        ds = simulate(population, scene, engine="direct", seed=seed, quiet=True)
-    t, who = ds.spike_time.values, ds.spike_afferent.values
-    inside = (t >= window[0]) & (t < window[1])
-    return np.bincount(who[inside], minlength=ds.sizes["afferent"]).astype(float)
+        warnings.simplefilter("ignore")  # the presets' calibration notes, not news here
+        return simulate(population, scene, engine="direct", seed=seed, quiet=True)
 
 
 def tilt_table(population, normal_n: float = 4.0, tilt_deg: float = TILT_DEG, directions: int = DIRECTIONS,
                seed: int = 0) -> dict:
     """Per type, the fractions of responding units above their normal-only response by 10% in some direction,
     halved and silenced in their worst direction, and the medians of best and worst over normal-only."""
+    from ddmm.population.analysis.physiology_everyday import window_counts
+
     kinds = np.asarray(population.afferent_type)
-    ramp_end = _ONSET + normal_n / 20.0 + 0.1
-    windows = {"SAI": _PLATEAU, "SAII": _PLATEAU, "RAI": (_ONSET, ramp_end)}
+    windows = {"SAI": _PLATEAU, "SAII": _PLATEAU, "RAI": (_ONSET, _ONSET + normal_n / 20.0 + 0.1)}
     angles = np.arange(directions) * 360.0 / directions
+    runs = [_simulate(population, tilt_scene(normal_n, tilt, a), seed)  # the normal load alone first
+            for tilt, a in [(0.0, 0.0)] + [(tilt_deg, a) for a in angles]]
     table = {}
     for kind, window in windows.items():
-        base = _counts(population, tilt_scene(normal_n, 0.0, 0.0), seed, window)
-        tilted = np.array([_counts(population, tilt_scene(normal_n, tilt_deg, a), seed, window) for a in angles])
-        mine = (kinds == kind) & (base > 0)
+        counts = np.array([window_counts(ds, 0, window)[0] for ds in runs], dtype=float)
+        mine = (kinds == kind) & (counts[0] > 0)
         if not mine.any():
             continue
-        b, r = base[mine], tilted[:, mine]
+        b, r = counts[0, mine], counts[1:, mine]
         table[kind] = {"units": int(mine.sum()), "above_10pct": float(np.mean((r > 1.1 * b).any(axis=0))),
                        "halved_worst": float(np.mean((r < 0.5 * b).any(axis=0))),
                        "silenced_worst": float(np.mean((r == 0).any(axis=0))),
@@ -91,16 +90,11 @@ def tilt_table(population, normal_n: float = 4.0, tilt_deg: float = TILT_DEG, di
 def peak_table(population, forces_n=(2.0, 4.0), rates_n_s=LOADING_RATES, seed: int = 0) -> dict:
     """Median SA-I peak 1/ISI (imp/s) and plateau rate (imp/s) per target force and loading rate, over SA-I that
     fire at least three spikes."""
-    from ddmm.population import simulate
-
     sai = np.flatnonzero(np.asarray(population.afferent_type) == "SAI")
     table = {}
     for force in forces_n:
         for rate in rates_n_s:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                ds = simulate(population, tilt_scene(force, 0.0, 0.0, rate, duration=2.0), engine="direct",
-                              seed=seed, quiet=True)
+            ds = _simulate(population, tilt_scene(force, 0.0, 0.0, rate, duration=2.0), seed)
             t, who = ds.spike_time.values, ds.spike_afferent.values
             peaks, plateaus = [], []
             for unit in sai:

@@ -407,8 +407,7 @@ def hold_widths(conditioning: Conditioning, tracker_sd: float = 0.0, smooth_sd: 
     noise = _HOLD_SDS * conditioning.noise_n
     shear = max(conditioning.shear_hold_n, noise * smooth_sd) if conditioning.shear_hold_n > 0 else 0.0
     normal = max(conditioning.normal_hold_n, noise * tracker_sd) if conditioning.normal_hold_n > 0 else 0.0
-    floors = [min(conditioning.shear_hold_n, shear), min(conditioning.shear_hold_n, shear),
-              min(conditioning.normal_hold_n, normal)]
+    floors = [conditioning.shear_hold_n, conditioning.shear_hold_n, conditioning.normal_hold_n]  # the settings
     return np.array([shear, shear, normal, conditioning.contact_on_n, *floors])
 
 

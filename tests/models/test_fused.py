@@ -21,6 +21,8 @@ PHYSIO = dataclasses.replace(load_spec("fingertip").current, shear_sai=0.5, shea
                              depth_rai=0.7)
 #: The presets with a half-wave FA-II drive too (their FA-I drive already is: negative_weight_rai < 1).
 HALF_WAVE = dataclasses.replace(PHYSIO, negative_weight_raii=0.0)
+#: The paper's currents with only the attenuation depth changed (no shear term: F_A alone carries it).
+DEPTH_ONLY = dataclasses.replace(CurrentParams(), depth_sai=0.5, depth_rai=0.3, depth_raii=0.7)
 #: Afferents in runs of one type (as the encoder orders them), tuned and untuned in each.
 TYPES = ["SAI"] * 4 + ["RAI"] * 4 + ["RAII"] * 3 + ["SAII"] * 3
 NAPS = ["selective", "broad", "none", "bipolar", "broad", "none", "selective", "bipolar",
@@ -69,10 +71,10 @@ def reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite=N
 
 @settings(max_examples=12, deadline=None)
 @given(seed=st.integers(0, 2**16), no_shear=st.sampled_from(["pass", "block", "smooth"]),
-       physio=st.sampled_from([0, 1, 2]), noisy=st.booleans(), cut=st.integers(1, 399))
+       physio=st.sampled_from([0, 1, 2, 3]), noisy=st.booleans(), cut=st.integers(1, 399))
 def test_fused_currents_equal_the_stage_by_stage_path(seed, no_shear, physio, noisy, cut):
     rng = np.random.default_rng(seed)
-    params = (CurrentParams(), PHYSIO, HALF_WAVE)[physio]
+    params = (CurrentParams(), PHYSIO, HALF_WAVE, DEPTH_ONLY)[physio]
     n = len(TYPES)
     theta, k, scale = rng.uniform(0, 360, n), rng.uniform(2.0, 5.0, n), rng.uniform(0.5, 2.0, n)
     cv = np.where(rng.random(n) < 0.7, rng.uniform(0.1, 1.0, n), 0.0)
