@@ -21,11 +21,12 @@ _COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA, _TONIC, _DEAD
 _N_AFF_ROWS = 14
 # Rows of the per-group float and integer tables.
 (_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _NEGATIVE, _DYN, _ALPHA_DYN, _FALL, _SHEAR_G, _OPP_SHEAR,
- _DEPTH) = range(12)
+ _DEPTH, _TRANSIENT, _ALPHA_TRANSIENT, _ALPHA_RISE) = range(15)
+_N_GRP_ROWS = 15
 _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = range(9)
 # Rows of the state after the 2 * n_sections filter rows.
-_OFFSET, _Y1, _Y2, _SLOW, _SMOOTH, _DYNC = range(6)
-_N_STATE = 6
+_OFFSET, _Y1, _Y2, _SLOW, _SMOOTH, _DYNC, _FASTC, _RISEC = range(8)
+_N_STATE = 8
 
 _RANGE = 512  # afferents per range of the front pass: its state and scratch fit in cache
 _SLICE = 1 << 17  # current elements per time slice of `FusedPipeline.currents`

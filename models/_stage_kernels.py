@@ -155,19 +155,27 @@ def stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_ada
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def dynamic_step(x, c, alpha, depth, fall):
-    """One sample of the dynamic response on the current: ``c += alpha (x - c)``;
-    ``max(x + depth (x - c) - fall c, 0)``."""
+def dynamic_step(x, c, k, r, alpha, alpha_k, alpha_r, depth, transient, fall):
+    """One sample of the dynamic response on the current: ``c += alpha (x - c)``; with ``transient``,
+    ``r += alpha_r (x - r)`` and ``k += alpha_k (r - k)``;
+    ``max(x + depth (x - c) + transient (r - k) - fall c, 0)``.  With ``transient`` 0 the sum is that of the
+    form without it, bit for bit."""
     c = c + alpha * (x - c)
-    return max((x + depth * (x - c)) - fall * c, 0.0), c
+    y = (x + depth * (x - c)) - fall * c
+    if transient != 0.0:
+        r = r + alpha_r * (x - r)
+        k = k + alpha_k * (r - k)
+        y = y + transient * (r - k)
+    return max(y, 0.0), c, k, r
 
 
 @nb.njit(cache=True, nogil=True)
-def dynamic_kernel(x, c, alpha, depth, fall):
-    """`dynamic_step` along axis 0, in place on ``x``, with state ``c`` (updated)."""
+def dynamic_kernel(x, c, k, r, alpha, alpha_k, alpha_r, depth, transient, fall):
+    """`dynamic_step` along axis 0, in place on ``x``, with states ``c``, ``k`` and ``r`` (updated)."""
     for n in range(x.shape[0]):
         for j in range(x.shape[1]):
-            x[n, j], c[j] = dynamic_step(x[n, j], c[j], alpha, depth, fall)
+            x[n, j], c[j], k[j], r[j] = dynamic_step(x[n, j], c[j], k[j], r[j], alpha, alpha_k, alpha_r, depth,
+                                                     transient, fall)
     return x
 
 

@@ -80,6 +80,9 @@ class FilterState:
         The current's low-pass state in mV/ms (before the bias).
     dyn : ndarray, shape (n_afferents,) or None
         The dynamic response's low-pass of the current in mV/ms (SA-I).
+    fast, rise : ndarray, shape (n_afferents,) or None
+        The fast transient's two low-passes of the current in mV/ms (SA-I):
+        of ``tau_transient_sai_s`` and of half that.
     """
 
     zi: np.ndarray
@@ -89,6 +92,8 @@ class FilterState:
     slow: np.ndarray | None = None
     smooth: np.ndarray | None = None
     dyn: np.ndarray | None = None
+    fast: np.ndarray | None = None
+    rise: np.ndarray | None = None
 
 
 def lowpass_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
@@ -172,7 +177,8 @@ def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams(),
     sos = _stage_sos(params.for_type(afferent_type), fs)
     zeros = np.zeros_like(f0)
     return FilterState(zi=np.zeros((sos.shape[0], 2, f0.size)), offset=f0, y1=zeros, y2=zeros.copy(),
-                       slow=zeros.copy(), smooth=zeros.copy(), dyn=zeros.copy())
+                       slow=zeros.copy(), smooth=zeros.copy(), dyn=zeros.copy(),
+                       fast=zeros.copy(), rise=zeros.copy())
 
 
 _NO_NORMALS = np.zeros((1, 0))  # no receptor noise: the stage kernel draws nothing

@@ -129,6 +129,19 @@ class CurrentParams:
         constant ``tau_dynamic_sai_s``, a fraction at every force.
     tau_dynamic_sai_s : float
         Ours: time constant of that low-pass in s.
+    transient_sai : float
+        Ours: depth of SA-I's fast transient on the current (dimensionless,
+        0: none): ``transient_sai (R - K)`` is added as well, with ``R`` and
+        ``K`` first-order low-passes of the current of time constants
+        ``tau_transient_sai_s / 2`` and ``tau_transient_sai_s`` (``K``
+        filters ``R``): a band-pass, so the receptor noise's fast part is not
+        amplified with it.  While the current rises, ``R - K`` is about
+        ``tau dI/dt``: a rate-of-loading response that peaks in fast loading
+        and has gone within a few ``tau`` of the hold, so it neither moves
+        the plateau nor the slower fall of ``fall_sai`` (docs/model.md, "What
+        changed").
+    tau_transient_sai_s : float
+        Ours: the longer time constant of that band-pass in s.
     shear_sai, shear_rai, shear_raii : float
         Ours: gain of the shear-magnitude term added to the type's F_A
         (dimensionless, N of drive per N of shear; 0: the paper's F_A, which
@@ -197,6 +210,8 @@ class CurrentParams:
     dynamic_sai: float = 0.0
     fall_sai: float = 0.0
     tau_dynamic_sai_s: float = 1.0
+    transient_sai: float = 0.0
+    tau_transient_sai_s: float = 0.05
     shear_sai: float = 0.0
     shear_rai: float = 0.0
     shear_raii: float = 0.0
@@ -223,7 +238,7 @@ class CurrentParams:
 
     def __post_init__(self):
         for name in ("g_sai", "g_rai", "g_raii", "g_saii", "cutoff_hz", "cutoff_saii_hz", "tau_adapt_sai_s",
-                     "tau_adapt_rai_s", "tau_dynamic_sai_s"):
+                     "tau_adapt_rai_s", "tau_dynamic_sai_s", "tau_transient_sai_s"):
             check_positive(getattr(self, name), name)
         _optional_positive(self, ("i_sat", "i_sat_sai", "i_sat_rai", "i_sat_raii", "i_max_sai", "i_max_rai",
                                   "i_max_raii", "i_max_saii"), "mV/ms")
@@ -241,7 +256,7 @@ class CurrentParams:
                 or not 0.0 <= self.phase_saii <= 1.0:
             raise ValueError(f"phase_saii must be a number in [0, 1], got {shown(self.phase_saii)}")
         for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii", "normal_saii",
-                     "bias_cv_saii", "dynamic_sai", "fall_sai", "excite_cv_sai", "excite_cv_rai", "excite_cv_raii",
+                     "bias_cv_saii", "dynamic_sai", "transient_sai", "fall_sai", "excite_cv_sai", "excite_cv_rai", "excite_cv_raii",
                      "excite_cv_saii", "shear_sai", "shear_rai", "shear_raii", "opponent_shear_sai",
                      "opponent_shear_rai", "opponent_shear_raii"):
             value = getattr(self, name)
@@ -292,7 +307,9 @@ class CurrentParams:
                             self._own("bias_cv", afferent_type, default=0.0), self._own("fall", afferent_type, default=0.0),
                             self._own("shear", afferent_type, default=0.0),
                             self._own("opponent_shear", afferent_type, default=0.0),
-                            float(self._own("depth", afferent_type, default=1.0)))
+                            float(self._own("depth", afferent_type, default=1.0)),
+                            float(self._own("transient", afferent_type, default=0.0)),
+                            float(self._own("tau_transient", afferent_type, "_s", 0.05)))
 
 
     def stage(self, afferent_type: str) -> TypeCurrentParams:
@@ -344,6 +361,9 @@ class TypeCurrentParams:
         How much shear against the preferred direction lowers that term (dimensionless).
     depth : float
         Depth of the NAP's attenuation of the normal force, in [0, 1] (1: the paper's F_A).
+    transient, tau_transient_s : float
+        Depth (dimensionless) and time constant (s) of the fast transient on
+        the current (SA-I's ``transient_sai``).
     """
 
     afferent_type: str
@@ -367,6 +387,8 @@ class TypeCurrentParams:
     shear: float = 0.0
     opponent_shear: float = 0.0
     depth: float = 1.0
+    transient: float = 0.0
+    tau_transient_s: float = 0.05
 
     @property
     def signed(self) -> bool:

@@ -38,6 +38,9 @@ which the physiological presets switch on (docs/model.md, "What changed in the m
   after the transducer: ``I + dynamic (I - J) - fall J`` with ``J`` a
   low-pass of the current (``tau_dynamic_sai_s``): an overshoot in fast
   loading and a fractional fall through a hold at every force.
+  ``transient_sai`` adds ``transient (R - K)``, a band-pass of the current
+  (first-order low-passes of ``tau_transient_sai_s / 2`` and
+  ``tau_transient_sai_s``): SA-I's peak rates while the load rises.
 * **Shear magnitude in the pressure types' drive.**  ``shear_sai``,
   ``shear_rai`` and ``shear_raii`` add a stretch-like term to F_A before the
   type's filter, ``x = max(0, F_A + shear_<type> * F_S * (AF - opponent_shear_<type> * (1 - AF)))``
@@ -224,8 +227,8 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
                          float(st.negative_weight), gain,
                          np.ascontiguousarray(normals) if noisy else _NO_NORMALS, cv_scale, noisy, st.signed)
     current = transduce_inplace(drive, st, excite)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
-    current, smooth, dyn = _after_transducer(current, st, state, m, fs, alpha_smooth, afferent_id)
-    return current, FilterState(zi, state.offset, y1, y2, slow, smooth, dyn)
+    current, smooth, dyn, fast, rise = _after_transducer(current, st, state, m, fs, alpha_smooth, afferent_id)
+    return current, FilterState(zi, state.offset, y1, y2, slow, smooth, dyn, fast, rise)
 
 
 def unit_thresholds(stage: TypeCurrentParams, sensitivity, n: int) -> np.ndarray:
@@ -251,11 +254,15 @@ def _after_transducer(current, st, state, m, fs, alpha_smooth, afferent_id):
     if st.tau_s is not None:
         current = smooth_kernel(current, smooth, alpha_smooth)
     dyn = np.zeros(m) if state.dyn is None else state.dyn.copy()
-    if st.dynamic > 0.0 or st.fall > 0.0:
-        current = dynamic_kernel(current, dyn, _alpha(st.tau_dynamic_s, fs), float(st.dynamic), float(st.fall))
+    fast = np.zeros(m) if state.fast is None else state.fast.copy()
+    rise = np.zeros(m) if state.rise is None else state.rise.copy()
+    if st.dynamic > 0.0 or st.fall > 0.0 or st.transient > 0.0:
+        current = dynamic_kernel(current, dyn, fast, rise, _alpha(st.tau_dynamic_s, fs), _alpha(st.tau_transient_s, fs),
+                                 _alpha(0.5 * st.tau_transient_s, fs), float(st.dynamic), float(st.transient),
+                                 float(st.fall))
     if st.bias != 0.0:
         current += tonic_current(st, afferent_id, m)
-    return current, smooth, dyn
+    return current, smooth, dyn, fast, rise
 
 
 def _alpha(tau_s: float, fs: float) -> float:

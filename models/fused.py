@@ -38,7 +38,9 @@ from ddmm.models._fused_drive import (
     _ADAPT,
     _ALPHA_ADAPT,
     _ALPHA_DYN,
+    _ALPHA_RISE,
     _ALPHA_SMOOTH,
+    _ALPHA_TRANSIENT,
     _BIAS,
     _COS,
     _CV,
@@ -47,9 +49,11 @@ from ddmm.models._fused_drive import (
     _DYN,
     _DYNC,
     _FALL,
+    _FASTC,
     _GAIN,
     _K,
     _N_AFF_ROWS,
+    _N_GRP_ROWS,
     _N_STATE,
     _NEGATIVE,
     _NO_FORCES,
@@ -65,6 +69,7 @@ from ddmm.models._fused_drive import (
     _P5,
     _PLAIN,
     _RANGE,
+    _RISEC,
     _SHEAR_G,
     _SIGMA,
     _SIGNED,
@@ -77,6 +82,7 @@ from ddmm.models._fused_drive import (
     _STOP,
     _THRESHOLD,
     _TIP,
+    _TRANSIENT,
     _TONIC,
     _TUNED_G,
     _Y1,
@@ -204,6 +210,7 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i
     sigma > 0) only: adding 0 * xi would leave every other current as it is.
     """
     smooth, dync = state[rows + _SMOOTH], state[rows + _DYNC]
+    fastc, risec = state[rows + _FASTC], state[rows + _RISEC]
     lowest = np.inf
     sub_ids = ids[sigma_idx]
     words, xi = np.empty(sigma_idx.size, np.uint64), np.empty(sigma_idx.size)
@@ -216,11 +223,13 @@ def _back(current, key, additive, ids, sample0, state, rows, aff_f, grp_f, grp_i
                 for j in range(hi - lo):
                     c[j] = c[j] + alpha * (x[j] - c[j])  # `smooth_kernel`
                     x[j] = c[j]
-            depth, fall = grp_f[_DYN, g], grp_f[_FALL, g]
-            if depth > 0.0 or fall > 0.0:
-                c, alpha = dync[lo:hi], grp_f[_ALPHA_DYN, g]
+            depth, fall, transient = grp_f[_DYN, g], grp_f[_FALL, g], grp_f[_TRANSIENT, g]
+            if depth > 0.0 or fall > 0.0 or transient > 0.0:
+                c, k, r = dync[lo:hi], fastc[lo:hi], risec[lo:hi]
+                alpha, alpha_k, alpha_r = grp_f[_ALPHA_DYN, g], grp_f[_ALPHA_TRANSIENT, g], grp_f[_ALPHA_RISE, g]
                 for j in range(hi - lo):
-                    x[j], c[j] = dynamic_step(x[j], c[j], alpha, depth, fall)
+                    x[j], c[j], k[j], r[j] = dynamic_step(x[j], c[j], k[j], r[j], alpha, alpha_k, alpha_r, depth,
+                                                          transient, fall)
             if bias != 0.0:
                 tonic = aff_f[_TONIC, lo:hi]
                 for j in range(hi - lo):
@@ -362,14 +371,16 @@ class FusedPipeline:
 
     def _group_tables(self, spans, consts, noise_cv, tuned):
         n_groups, n_sec = len(spans), max([sos.shape[0] for _, sos, _, _ in consts] + [1])
-        grp_f, grp_i = np.zeros((12, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
+        grp_f, grp_i = np.zeros((_N_GRP_ROWS, n_groups)), np.zeros((9, n_groups), dtype=np.int64)
         sos_all = np.zeros((n_groups, n_sec, 6))
         for g, ((a, b), (st, sos, alpha_adapt, alpha_smooth)) in enumerate(zip(spans, consts)):
             sos_all[g, :sos.shape[0]] = sos
             plain = st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
             grp_f[:, g] = [st.adapt, alpha_adapt, st.threshold, alpha_smooth, st.bias, st.negative_weight, st.dynamic,
                            float(-np.expm1(-1.0 / (self.fs * st.tau_dynamic_s))), st.fall,  # `currents._alpha`
-                           st.shear, st.opponent_shear, st.depth]
+                           st.shear, st.opponent_shear, st.depth, st.transient,
+                           float(-np.expm1(-1.0 / (self.fs * st.tau_transient_s))),
+                           float(-np.expm1(-1.0 / (self.fs * 0.5 * st.tau_transient_s)))]
             grp_i[:, g] = [sos.shape[0], st.derivative, st.signed, plain, np.any(noise_cv[a:b] > 0),
                            st.tau_s is not None, tuned[a], a, b]
         return grp_f, grp_i, sos_all

@@ -94,7 +94,7 @@ _RUNNERS = dict(_core.RUNNERS)
 
 #: Protocol modules beyond the core battery, in the order their protocols run.
 EXTENSIONS = ("physiology_vibration", "physiology_variability", "physiology_slow", "physiology_fields",
-              "physiology_shear", "physiology_everyday")
+              "physiology_shear", "physiology_everyday", "physiology_tilt")
 _MERGED: set = set()
 
 

@@ -14,6 +14,12 @@ end + 0.1 s).
 ``shear_variant``: the same at 4 N normal with the tangential ramp at 4 N/s
 (no gain was set on it: a prediction).
 
+SA rows compare each unit with itself under the normal load alone: the
+statistic is the median over the units that fire under it of their rate
+at each magnitude over that normal-only rate (so a row reads what the
+tangential load adds or takes away, never growth from a level the
+attenuation has already lowered).
+
 Statistics of the *opposite* direction (and the preferred / opposite ratios)
 use the unipolar afferents only (NAP ``selective`` or ``broad``): a bipolar
 afferent's profile peaks at theta_T and at theta_T + 180 deg, so for it the
@@ -42,18 +48,20 @@ def _p(name, kind, protocol, statistic, unit="1"):
 
 
 PROPERTIES = dict([
-    _p("shear_pref_SAI", "SAI", "shear", "median rate, 1 N shear preferred / no shear (2 N normal)"),
-    _p("shear_opp_SAI", "SAI", "shear", "median rate, 1 N shear opposite / no shear (2 N normal; unipolar)"),
-    _p("shear_growth_SAI", "SAI", "shear", "smallest rise of the median rate, 0 -> 0.25 -> 0.5 -> 1 N preferred", "1/s"),
-    _p("shear_fall_SAI", "SAI", "shear", "largest change of the median rate, 0 -> 0.25 -> 0.5 -> 1 N opposite (unipolar)", "1/s"),
+    _p("shear_pref_SAI", "SAI", "shear", "median per-unit rate, 1 N shear preferred / normal only (2 N)"),
+    _p("shear_opp_SAI", "SAI", "shear", "median per-unit rate, 1 N shear opposite / normal only (2 N; unipolar)"),
+    _p("shear_growth_SAI", "SAI", "shear", "smallest rise of the median per-unit rate / normal only, 0 -> 0.25 -> "
+       "0.5 -> 1 N preferred"),
+    _p("shear_fall_SAI", "SAI", "shear", "largest change of the median per-unit rate / normal only, 0 -> 0.25 -> "
+       "0.5 -> 1 N opposite (unipolar)"),
     _p("shear_growth_RAI", "RAI", "shear", "smallest rise of the mean ramp count, 0 -> 0.25 -> 0.5 -> 1 N preferred"),
     _p("shear_dir_RAI", "RAI", "shear", "mean ramp count, 1 N preferred / opposite (unipolar)"),
     _p("shear_ramp_RAI", "RAI", "shear", "fraction firing late in a 2 N/s tangential ramp (0.4-1 N, preferred)"),
     _p("shear_dir_RAII", "RAII", "shear", "mean ramp count, 1 N preferred / opposite (unipolar)"),
-    _p("shear_growth_SAII", "SAII", "shear", "smallest rise of the median rate, 0 -> 0.25 -> 0.5 -> 1 N preferred",
-       "1/s"),
-    _p("shear_variant_SAI", "SAI", "shear_variant",
-       "4 N normal, 4 N/s shear: min(smallest rise preferred, -largest change opposite (unipolar))", "1/s"),
+    _p("shear_growth_SAII", "SAII", "shear", "smallest rise of the median per-unit rate / normal only, 0 -> 0.25 -> "
+       "0.5 -> 1 N preferred"),
+    _p("shear_variant_SAI", "SAI", "shear_variant", "4 N normal, 4 N/s shear: min(smallest rise preferred, -largest "
+       "change opposite (unipolar)) of the median per-unit rate / normal only"),
     _p("shear_variant_RAI", "RAI", "shear_variant",
        "4 N normal, 4 N/s shear: smallest rise of the mean ramp count, 0 -> 0.25 -> 0.5 -> 1 N preferred"),
 ])
@@ -87,12 +95,22 @@ def _measure(population, context, normal_n, rate_n_s):
     return ds, sa, fa, late
 
 
-def _curves(values, mask, stat=np.mean):
-    """Population statistic (mean; SA rates: median, the typical afferent's) at 0 then the magnitudes,
-    preferred and opposite."""
-    mean = stat(values[:, mask], axis=1)
+def _curves(values, mask):
+    """Mean over ``mask`` at 0 then the magnitudes, preferred and opposite."""
+    mean = np.mean(values[:, mask], axis=1)
     n = len(MAGNITUDES_N)
     return np.r_[mean[0], mean[1:1 + n]], np.r_[mean[0], mean[1 + n:]]
+
+
+def _relative(values, mask):
+    """Median over the units of ``mask`` that fire under the normal load alone of their rate over that rate, at 0
+    (1) then the magnitudes, preferred and opposite (1s where no unit fires)."""
+    mine = mask & (values[0] > 0)
+    if not mine.any():
+        return np.ones(1 + len(MAGNITUDES_N)), np.ones(1 + len(MAGNITUDES_N))
+    ratio = np.median(values[:, mine] / values[0, mine], axis=1)
+    n = len(MAGNITUDES_N)
+    return np.r_[1.0, ratio[1:1 + n]], np.r_[1.0, ratio[1 + n:]]
 
 
 def _unipolar(ds):
@@ -109,9 +127,9 @@ def _shear(population, context) -> tuple:
     out, data = {}, {"sa_rate": sa, "fa_count": fa, "type": ds.afferent_type.values, "nap": ds.nap.values}
     uni = _unipolar(ds)
     if _of(ds, "SAI").any():
-        pref = _curves(sa, _of(ds, "SAI"), np.median)[0]
-        opp = _curves(sa, _of(ds, "SAI") & uni, np.median)[1]
-        out.update(shear_pref_SAI=_ratio(pref[-1], pref[0]), shear_opp_SAI=_ratio(opp[-1], opp[0]),
+        pref = _relative(sa, _of(ds, "SAI"))[0]
+        opp = _relative(sa, _of(ds, "SAI") & uni)[1]
+        out.update(shear_pref_SAI=float(pref[-1]), shear_opp_SAI=float(opp[-1]),
                    shear_growth_SAI=float(np.diff(pref).min()), shear_fall_SAI=float(np.diff(opp).max()))
     for kind in ("RAI", "RAII"):
         if _of(ds, kind).any():
@@ -123,7 +141,7 @@ def _shear(population, context) -> tuple:
     if _of(ds, "RAI").any():
         out["shear_ramp_RAI"] = float(np.mean(late[_of(ds, "RAI")] > 0))
     if _of(ds, "SAII").any():
-        out["shear_growth_SAII"] = float(np.diff(_curves(sa, _of(ds, "SAII"), np.median)[0]).min())
+        out["shear_growth_SAII"] = float(np.diff(_relative(sa, _of(ds, "SAII"))[0]).min())
     return out, data
 
 
@@ -131,8 +149,8 @@ def _shear_variant(population, context) -> tuple:
     ds, sa, fa, _ = _measure(population, context, 4.0, 4.0)
     out = {}
     if _of(ds, "SAI").any():
-        pref = _curves(sa, _of(ds, "SAI"), np.median)[0]
-        opp = _curves(sa, _of(ds, "SAI") & _unipolar(ds), np.median)[1]
+        pref = _relative(sa, _of(ds, "SAI"))[0]
+        opp = _relative(sa, _of(ds, "SAI") & _unipolar(ds))[1]
         out["shear_variant_SAI"] = float(min(np.diff(pref).min(), -np.diff(opp).max()))
     if _of(ds, "RAI").any():
         out["shear_variant_RAI"] = float(np.diff(_curves(fa, _of(ds, "RAI"))[0]).min())

@@ -15,9 +15,11 @@ population are simulated.
   SA-I: the fractional fall of the population rate from the first to the
   last 0.5 s of each hold.
 * ``slow_fast``: a 30 N/s ramp to 4 N and, as a variant, a 20 N/s ramp to
-  2 N, each held 2 s.  SA-I peak/plateau: the median over afferents of the
-  largest 1/ISI from the ramp's start to 0.1 s after its end, over the mean
-  rate in the last 1 s of the hold.
+  2 N, each held 2 s; and a 4 N/s ramp to 4 N.  Over the SA-I that fire in
+  the last 1 s of the hold: the median of their largest 1/ISI from the
+  ramp's start to 0.1 s after its end (the peak), of that peak over their
+  mean rate in that last second (peak/plateau), and the median plateau at
+  30 N/s over the one at 4 N/s (the plateau codes force, not loading rate).
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ __all__ = ["PROPERTIES", "PROTOCOLS", "RUNNERS", "hold_scene"]
 
 _TYPES = ("SAI", "SAII")
 _FORCES = (0.5, 2.0, 8.0)
-_FAST = ((4.0, 30.0), (2.0, 20.0))  # (force N, rate N/s)
+_FAST = ((4.0, 30.0), (2.0, 20.0), (4.0, 4.0))  # (force N, rate N/s)
 _ONSET, _HOLD = 0.2, 2.0  # s
 
 PROPERTIES = {name: Property(name, kind, protocol, statistic, unit) for name, kind, protocol, statistic, unit in (
@@ -45,6 +47,9 @@ PROPERTIES = {name: Property(name, kind, protocol, statistic, unit) for name, ki
     ("peak_plateau_SAI", "SAI", "slow_fast", "median peak 1/ISI over plateau rate, 30 N/s to 4 N", "1"),
     ("peak_plateau_2N_SAI", "SAI", "slow_fast", "median peak 1/ISI over plateau rate, 20 N/s to 2 N (variant)",
      "1"),
+    ("peak_rate_SAI", "SAI", "slow_fast", "median peak 1/ISI in loading, 30 N/s to 4 N", "1/s"),
+    ("peak_rate_2N_SAI", "SAI", "slow_fast", "median peak 1/ISI in loading, 20 N/s to 2 N (variant)", "1/s"),
+    ("plateau_rate_SAI", "SAI", "slow_fast", "median plateau rate at 4 N, loaded at 30 N/s over 4 N/s", "1"),
 )}
 PROTOCOLS = ("slow_rest", "slow_normal", "slow_fast")
 
@@ -107,8 +112,9 @@ def _slow_normal(population, context):
     return out, data
 
 
-def _peak_plateau(ds, condition, force, rate):
-    """Median over SA-I of peak 1/ISI in loading (to 0.1 s after the ramp) over the last-second plateau rate."""
+def _peaks(ds, condition, force, rate):
+    """Peak 1/ISI in loading (to 0.1 s after the ramp) and last-second plateau rate (1/s) of the SA-I that fire on
+    the plateau."""
     top = _ONSET + force / rate
     sa = np.flatnonzero(_of(ds, "SAI"))
     plateau = _rates(ds, top + _HOLD - 1.0, top + _HOLD, condition)[sa]
@@ -121,14 +127,21 @@ def _peak_plateau(ds, condition, force, rate):
     peak = np.zeros(ds.sizes["afferent"])
     np.maximum.at(peak, aff[1:][same], 1.0 / np.diff(t)[same])
     ok = plateau > 0
-    return float(np.median(peak[sa][ok] / plateau[ok])) if ok.any() else 0.0
+    return peak[sa][ok], plateau[ok]
+
+
+def _median(x) -> float:
+    return float(np.median(x)) if np.size(x) else 0.0
 
 
 def _slow_fast(population, context):
-    ds = _simulate(population, [hold_scene(f, r, f"fast_{r:g}") for f, r in _FAST], context)
+    ds = _simulate(population, [hold_scene(f, r, f"fast_{r:g}_{f:g}") for f, r in _FAST], context)
     if not _of(ds, "SAI").any():
         return {}, {}
-    out = {"peak_plateau_SAI": _peak_plateau(ds, 0, *_FAST[0]), "peak_plateau_2N_SAI": _peak_plateau(ds, 1, *_FAST[1])}
+    (peak4, plat4), (peak2, plat2), (_, slow4) = (_peaks(ds, c, f, r) for c, (f, r) in enumerate(_FAST))
+    out = {"peak_plateau_SAI": _median(peak4 / plat4), "peak_plateau_2N_SAI": _median(peak2 / plat2),
+           "peak_rate_SAI": _median(peak4), "peak_rate_2N_SAI": _median(peak2),
+           "plateau_rate_SAI": _median(plat4) / max(_median(slow4), 1e-12)}
     return out, {"dataset": ds}
 
 

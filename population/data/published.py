@@ -98,7 +98,24 @@ def _physiology_reference() -> dict:
 def _dynamic_reference(R) -> dict:
     """Reference ranges of the protocol modules beyond the core battery (phase locking, variability, shear)."""
     return {**_vibration_reference(R), **_variability_reference(R), **_shear_reference(R), **_slow_reference(R),
-            **_field_reference(R), **_everyday_reference(R)}
+            **_field_reference(R), **_everyday_reference(R), **_tilt_reference(R)}
+
+
+def _tilt_reference(R) -> dict:
+    """Tilted loads against the normal load alone (docs/references.md rows 9, 22;
+    `ddmm.population.analysis.physiology_tilt`)."""
+    src = ("docs/references.md rows 9, 22: in its preferred direction tangential load adds to a unit's response to "
+           "the normal load, against it the load subtracts")
+    most, variant = ": most units rise in some direction (R: a broad range)", "; a variant: 2 N tilted 30 deg, 8 directions"
+    return {
+        "tilt_above_SAI": R(0.5, 1.0, src + most + "; shear_sai and depth_sai set by hand to it", "constrained", "R"),
+        "tilt_silenced_SAI": R(0.0, 0.2, src + ": it lowers, seldom silences (R); shear_sai and depth_sai set by "
+                               "hand to it", "constrained", "R"),
+        "tilt_above_RAI": R(0.5, 1.0, src + most, "held out", "R"),
+        "tilt_above_SAII": R(0.5, 1.0, src + most, "held out", "R"),
+        "tilt_variant_above_SAI": R(0.5, 1.0, src + most + variant, "held out", "R"),
+        "tilt_variant_above_RAI": R(0.5, 1.0, src + most + variant, "held out", "R"),
+    }
 
 
 def _everyday_reference(R) -> dict:
@@ -233,6 +250,10 @@ def _slow_reference(R) -> dict:
         "adaptation_8N_SAI": R(0.1, 0.75, adapt + "; dynamic_sai set by hand to it", "constrained", "V"),
         "peak_plateau_SAI": R(1.5, inf, peak + "; dynamic_sai set by hand to it", "constrained", "R"),
         "peak_plateau_2N_SAI": R(1.5, inf, peak + " (a variant: 20 N/s to 2 N)", "held out", "R"),
+        "peak_rate_SAI": R(100.0, 300.0, peak + "; transient_sai set by hand to it", "constrained", "R"),
+        "peak_rate_2N_SAI": R(100.0, 300.0, peak + " (a variant: 20 N/s to 2 N)", "held out", "R"),
+        "plateau_rate_SAI": R(0.8, 1.25, "docs/references.md rows 5, 6: the SA-I plateau codes the force, not how "
+                              "fast it was reached (R: within 20%)", "held out", "R"),
     }
 
 

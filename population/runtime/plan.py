@@ -196,7 +196,7 @@ def af_threshold(no_shear: str) -> float:
 def _quiet(pop, sel, scene, scale, computes_af, af_constant):
     """Afferents whose noise-free current is identically zero (they never leave rest)."""
     stretch = pop.afferent_type[sel] == "SAII"
-    blocked = (pop.nap[sel] != UNTUNED) & (not computes_af) & (af_constant == 0.0)
+    blocked = (pop.nap[sel] != UNTUNED) & (not computes_af) & (af_constant == 0.0) & ~_shallow(pop, sel)
     sheared = _shear_gained(pop, sel) & (scene.max_shear() > 0.0)  # the shear-magnitude term drives them
     pressed = (scale == 0.0) | ((blocked | (not np.any(scene.fz > 0.0))) & ~sheared)
     bias = pop.current.bias_saii
@@ -216,6 +216,12 @@ def _of_type(afferent_type, types) -> np.ndarray:
     for t in types:
         out |= afferent_type == t
     return out
+
+
+def _shallow(pop, sel):
+    """Whether each afferent's type keeps part of its normal drive at AF = 0 (``CurrentParams.depth_<type>`` < 1)."""
+    shallow = [t for t in AFFERENT_TYPES if t != "SAII" and pop.current.for_type(t).depth < 1.0]
+    return _of_type(pop.afferent_type[sel], shallow)
 
 
 def _shear_gained(pop, sel):

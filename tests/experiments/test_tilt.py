@@ -1,19 +1,11 @@
-"""The tilted-load and SA-I peak protocols (`ddmm.experiments.validation.tilt`): scenes and a small run."""
+"""The tilted-load and SA-I peak command (`ddmm.experiments.validation.tilt`): a small run (the scenes and
+fractions are tested with `ddmm.population.analysis.physiology_tilt`)."""
 
 import numpy as np
 import pytest
 
-from ddmm.experiments.validation.tilt import peak_table, tilt_scene, tilt_table
+from ddmm.experiments.validation.tilt import peak_table, tilt_table
 from ddmm.population import sample_population
-
-
-def test_a_tilt_scene_tilts_the_resultant_toward_its_direction():
-    scene = tilt_scene(4.0, 20.0, 135.0)
-    hold = slice(500, None)
-    tangential = np.hypot(scene.fx[hold], scene.fy[hold])
-    np.testing.assert_allclose(np.degrees(np.arctan2(tangential, scene.fz[hold])), 20.0)
-    np.testing.assert_allclose(np.degrees(np.arctan2(scene.fy[hold], scene.fx[hold])), 135.0)
-    assert scene.fz[99] == 0.0 and scene.fz[150] == pytest.approx(1.0, abs=0.03)  # 20 N/s from 0.1 s
 
 
 @pytest.fixture(scope="module")

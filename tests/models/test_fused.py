@@ -18,7 +18,7 @@ FS = 1000.0
 #: The fingertip's stage with the shear-magnitude term on, so every branch is compared.
 PHYSIO = dataclasses.replace(load_spec("fingertip").current, shear_sai=0.5, shear_rai=4.0, shear_raii=1.0,
                              opponent_shear_sai=1.0, opponent_shear_rai=0.5, opponent_shear_raii=0.25, depth_sai=0.5,
-                             depth_rai=0.7)
+                             depth_rai=0.7, transient_sai=1.5, tau_transient_sai_s=0.03)
 #: The presets with a half-wave FA-II drive too (their FA-I drive already is: negative_weight_rai < 1).
 HALF_WAVE = dataclasses.replace(PHYSIO, negative_weight_raii=0.0)
 #: The paper's currents with only the attenuation depth changed (no shear term: F_A alone carries it).

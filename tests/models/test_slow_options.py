@@ -5,6 +5,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from ddmm.models._stage_kernels import dynamic_kernel
 from ddmm.models.attenuation import stretch_drive
 from ddmm.models.currents import CurrentParams, bias_multiplier, current_core, initial_phase
 from ddmm.models.fused import FusedPipeline
@@ -72,9 +73,36 @@ def _sai_current(params, force, n=3000, rise=100):
 
 @pytest.mark.parametrize("force", [0.5, 8.0])
 def test_sai_current_falls_by_a_fraction_through_a_hold_at_every_force(force):
-    off = _sai_current(replace(PHYSIO, dynamic_sai=0.0, fall_sai=0.0), force)
-    on = _sai_current(PHYSIO, force)
+    off = _sai_current(replace(PHYSIO, dynamic_sai=0.0, fall_sai=0.0, transient_sai=0.0), force)
+    on = _sai_current(replace(PHYSIO, transient_sai=0.0), force)  # the fast transient has its own test
     fall_off = 1.0 - off[-500:].mean() / off[100:600].mean()
     fall_on = 1.0 - on[-500:].mean() / on[100:600].mean()
     assert fall_on > fall_off + 0.1  # the lasting fall adds a tenth or more at 0.5 N and at 8 N alike
     assert on[100:200].max() > off[100:200].max()  # and the overshoot in loading
+
+
+def test_the_transient_is_a_band_pass_of_tau_times_the_slope():
+    """On a ramp of slope a the two low-passes lag by a tau / 2 and a tau: ``transient (R - K)`` tends to
+    ``transient a tau``; on a constant it tends to 0, and with ``transient`` 0 nothing moves (bit for bit)."""
+    fs, tau, a = 1000.0, 0.1, 5.0  # Hz, s, mV/ms per s
+    x = a * np.arange(3000) / fs
+    states = [np.zeros(1) for _ in range(3)]
+    alphas = [float(-np.expm1(-1.0 / (fs * t))) for t in (1.0, tau, tau / 2)]
+    out = dynamic_kernel(x[:, None].copy(), *states, *alphas, 0.0, 2.0, 0.0)[:, 0]
+    assert out[-1] - x[-1] == pytest.approx(2.0 * a * tau, rel=0.02)
+    flat = dynamic_kernel(np.full((3000, 1), 7.0), *[np.zeros(1) for _ in range(3)], *alphas, 0.0, 2.0, 0.0)
+    assert flat[-1, 0] == pytest.approx(7.0, rel=1e-9)
+    none = dynamic_kernel(x[:, None].copy(), *[np.zeros(1) for _ in range(3)], *alphas, 0.1, 0.0, 0.2)[:, 0]
+    c, plain = 0.0, []
+    for value in x:  # the form without the transient, written out
+        c = c + alphas[0] * (value - c)
+        plain.append(max((value + 0.1 * (value - c)) - 0.2 * c, 0.0))
+    np.testing.assert_array_equal(none, plain)
+
+
+def test_the_transient_raises_fast_loading_and_leaves_the_plateau():
+    off = _sai_current(replace(PHYSIO, transient_sai=0.0), 4.0, rise=130)
+    on = _sai_current(PHYSIO, 4.0, rise=130)
+    assert on[:130].max() > 1.3 * off[:130].max()  # a 30 N/s ramp: the transient's peak
+    # gone within a few tau of the hold, but for tau times the slope of the hold's own slow fall (< 0.5%)
+    np.testing.assert_allclose(on[-500:], off[-500:], rtol=5e-3)

@@ -42,8 +42,8 @@ def test_transducer_bound_holds_with_receptor_noise(seed, scale, cv, kind):
     normals = rng.standard_normal((4, 400))
     i, _ = current_core(f, FS, kind, PHYSIO, None, None, normals, np.full(4, cv))
     bound = {"SAI": PHYSIO.i_max_sai, "RAI": PHYSIO.i_max_rai, "RAII": PHYSIO.i_max_raii}[kind]
-    if kind == "SAI":  # SA-I's dynamic response acts on the bounded current: I + dynamic (I - J), J >= 0
-        bound *= 1.0 + PHYSIO.dynamic_sai
+    if kind == "SAI":  # SA-I's dynamic response acts on the bounded current: I + dynamic (I - J) + transient (R - K),
+        bound *= 1.0 + PHYSIO.dynamic_sai + PHYSIO.transient_sai  # J, K >= 0 and R <= the bound
     assert np.all(i >= 0.0) and np.all(i <= bound)
 
 

@@ -36,3 +36,14 @@ def test_shear_term_passes_and_the_paper_form_fails(fingertip):
     rows, _ = physiology.score_physiology(paper, PHYSIOLOGY_REFERENCE, properties=NAMES, seed=0)
     failing = {r["name"] for r in rows if not r["pass"]}
     assert {"shear_pref_SAI", "shear_ramp_RAI", "shear_dir_RAI"} <= failing
+
+
+def test_sa_rows_compare_each_unit_with_its_own_normal_only_rate():
+    """The median of per-unit ratios over units that fire under the normal load alone, not a ratio of medians."""
+    import numpy as np
+
+    # conditions: normal only, preferred 0.25 / 0.5 / 1 N, opposite 0.25 / 0.5 / 1 N; units: 10, 40, silent
+    values = np.array([[10.0, 40.0, 0.0], [12, 40, 5], [14, 44, 5], [20, 44, 5], [8, 30, 0], [5, 20, 0], [0, 10, 0]])
+    pref, opp = physiology_shear._relative(values, np.ones(3, bool))
+    np.testing.assert_allclose(pref, [1.0, 1.1, 1.25, 1.55])  # medians of (1.2, 1), (1.4, 1.1), (2, 1.1)
+    np.testing.assert_allclose(opp, [1.0, 0.775, 0.5, 0.125])

@@ -41,3 +41,12 @@ def test_without_the_options_the_slow_rows_fail(slow_pop):
     values = _values(replace(slow_pop, current=off), ["normal_coding_SAII", "rest_spread_SAII", "start_synchrony_SAII",
                                                        "adaptation_8N_SAI"])
     assert not any(ok for _, ok in values.values()), values
+
+
+def test_sa_i_peaks_need_the_transient_and_the_plateau_keeps_to_force(slow_pop):
+    names = ["peak_rate_SAI", "peak_rate_2N_SAI", "plateau_rate_SAI"]
+    values = _values(slow_pop, names)
+    assert all(ok for _, ok in values.values()), values
+    values = _values(replace(slow_pop, current=replace(slow_pop.current, transient_sai=0.0)), names)
+    assert not values["peak_rate_SAI"][1] and not values["peak_rate_2N_SAI"][1], values
+    assert values["plateau_rate_SAI"][1], values  # the plateau never depended on the transient

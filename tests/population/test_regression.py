@@ -57,19 +57,21 @@ from ._pinned_digest import AFFERENTS, pinned_env
 #: 0468a5e7...).  Re-recorded when FA-II's high-pass went 120 -> 200 Hz and D 2 -> 0.5 (preset values only,
 #: no code: the earlier presets give the earlier digests, 789a4251..., 21973, 1ceee0e5...).
 #: Re-recorded when units took a per-unit sensitivity (docs/model.md, "Units that differ"): the presets
-#: switched on its spread, FA-I's dead zone went 2 -> 0.75 N/s and the NAP mixes were refitted.  With the
-#: presets of before (`BEFORE`, run from `_pinned_digest.BEFORE_SENSITIVITY`) the code still gives the
-#: earlier digests, and this test holds it to them.
+#: switched on its spread, FA-I's dead zone went 2 -> 0.75 N/s and the NAP mixes were refitted (with the
+#: presets of before the code gave the previous digests, afb0ae7e..., 22108, 196b701d...).
+#: Re-recorded when SA-I took `depth_sai` 0.5, the re-tuned shear term and the fast transient
+#: (`transient_sai`, `adapt_sai` 1 -> 0.7).  With the presets of before (`BEFORE`, run from
+#: `_pinned_digest.BEFORE_PRESETS`) the code still gives the earlier digests, and this test holds it to them.
 RECORDED = {
+    "spikes": "3fe327cd43535e76fba15b67cbe6af8d7e1ea1bb7a3f8cbe72ca39d88480500e",
+    "n_spikes": 26325,
+    "currents": "85b23d990e1060c3c0c6d22aee097439eac3ec9ca136cd22dfd4aec5fac46139",
+}
+#: The digests of the presets before the SA-I transient and depth (the previous `RECORDED`).
+BEFORE = {
     "spikes": "ada45d4b20781082fbb1cfa913091ad745d94f8e68934690708f9d48d10cfc79",
     "n_spikes": 22056,
     "currents": "51376b60c856540f8c8c3621b4dd708f8fa899dbbccb5d8f76162f71a2b06f0a",
-}
-#: The digests of the presets before per-unit sensitivity (the previous `RECORDED`).
-BEFORE = {
-    "spikes": "afb0ae7e5353514748834aa18e0a478269037d3460035bd1672d1a0dd24c38db",
-    "n_spikes": 22108,
-    "currents": "196b701d1b4e01d2f2dae869385af93c878b3480be1439155f4bcb71a56d098e",
 }
 #: Where they were recorded: the bits of libm and of numpy's baseline loops are the platform's.
 RECORDED_ON = "x86_64 Linux, glibc 2.36, numpy 2.3 (baseline SSE SSE2 SSE3)"
@@ -95,7 +97,7 @@ def test_spikes_and_currents_under_pinned_dispatch_equal_the_recorded_digests():
     assert (run["numba_cpu_name"], run["numba_cpu_features"], run["numpy_dispatch"]) == ("generic", "", [])
     host = f"{platform.machine()} {platform.system()}, {' '.join(platform.libc_ver())}, numpy {np.__version__}"
     assert {key: run[key] for key in RECORDED} == RECORDED, f"recorded on {RECORDED_ON}; this host: {host}"
-    assert run["before_sensitivity"] == BEFORE, "with the presets of before, the code must give the earlier digests"
+    assert run["before"] == BEFORE, "with the presets of before, the code must give the earlier digests"
 
 
 def test_noise_equals_the_recorded_digest():
