@@ -158,14 +158,15 @@ def stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_ada
 def dynamic_step(x, c, k, r, alpha, alpha_k, alpha_r, depth, transient, fall):
     """One sample of the dynamic response on the current: ``c += alpha (x - c)``; with ``transient``,
     ``r += alpha_r (x - r)`` and ``k += alpha_k (r - k)``;
-    ``max(x + depth (x - c) + transient (r - k) - fall c, 0)``.  With ``transient`` 0 the sum is that of the
-    form without it, bit for bit."""
+    ``max(x + depth (x - c) + transient max(r - k, 0) - fall c, 0)``.  With ``transient`` 0 the sum is that
+    of the form without it, bit for bit."""
     c = c + alpha * (x - c)
     y = (x + depth * (x - c)) - fall * c
     if transient != 0.0:
         r = r + alpha_r * (x - r)
         k = k + alpha_k * (r - k)
-        y = y + transient * (r - k)
+        if r > k:  # rising current only: a loading response, nothing subtracted while it falls
+            y = y + transient * (r - k)
     return max(y, 0.0), c, k, r
 
 

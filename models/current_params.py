@@ -131,11 +131,12 @@ class CurrentParams:
         Ours: time constant of that low-pass in s.
     transient_sai : float
         Ours: depth of SA-I's fast transient on the current (dimensionless,
-        0: none): ``transient_sai (R - K)`` is added as well, with ``R`` and
+        0: none): ``transient_sai max(R - K, 0)`` is added as well, with ``R`` and
         ``K`` first-order low-passes of the current of time constants
         ``tau_transient_sai_s / 2`` and ``tau_transient_sai_s`` (``K``
         filters ``R``): a band-pass, so the receptor noise's fast part is not
-        amplified with it.  While the current rises, ``R - K`` is about
+        amplified with it, rectified, so that it answers loading and takes
+        nothing away in unloading.  While the current rises, ``R - K`` is about
         ``tau dI/dt``: a rate-of-loading response that peaks in fast loading
         and has gone within a few ``tau`` of the hold, so it neither moves
         the plateau nor the slower fall of ``fall_sai`` (docs/model.md, "What

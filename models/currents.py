@@ -38,7 +38,7 @@ which the physiological presets switch on (docs/model.md, "What changed in the m
   after the transducer: ``I + dynamic (I - J) - fall J`` with ``J`` a
   low-pass of the current (``tau_dynamic_sai_s``): an overshoot in fast
   loading and a fractional fall through a hold at every force.
-  ``transient_sai`` adds ``transient (R - K)``, a band-pass of the current
+  ``transient_sai`` adds ``transient max(R - K, 0)``, a rectified band-pass of the current
   (first-order low-passes of ``tau_transient_sai_s / 2`` and
   ``tau_transient_sai_s``): SA-I's peak rates while the load rises.
 * **Shear magnitude in the pressure types' drive.**  ``shear_sai``,

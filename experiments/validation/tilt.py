@@ -56,7 +56,7 @@ def tilt_table(population, normal_n: float = 4.0, tilt_deg: float = TILT_DEG, di
     context = {"seed": seed, "engine": "direct", "no_shear": "smooth"}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return _tilt_table(population, context, normal_n, tilt_deg, directions, trials=trials)
+        return _tilt_table(population, context, normal_n, tilt_deg, directions, trials=trials, max_units=None)
 
 
 def peak_table(population, forces_n=(2.0, 4.0), rates_n_s=LOADING_RATES, seed: int = 0) -> dict:

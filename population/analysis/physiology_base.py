@@ -50,6 +50,19 @@ def _rates(ds, t0, t1, condition=0):
     return counts / ds.sizes["trial"] / (t1 - t0)
 
 
+def _spaced(population, kinds, max_units: int):
+    """At most ``max_units`` afferents of each type in ``kinds``, evenly spaced in population order (None: none),
+    so that a protocol costs on the hand what it costs on the fingertip."""
+    keep = []
+    for kind in kinds:
+        idx = np.flatnonzero(population.afferent_type == kind)
+        if idx.size > max_units:
+            idx = idx[np.linspace(0, idx.size - 1, max_units).round().astype(np.int64)]
+        keep.append(idx)
+    keep = np.sort(np.concatenate(keep)) if keep else np.zeros(0, np.int64)
+    return population.select(keep) if keep.size else None
+
+
 def _of(ds, kind):
     """Mask of the afferents of type ``kind`` in a run's dataset."""
     return ds.afferent_type.values == kind

@@ -30,6 +30,7 @@ import numpy as np
 
 from ddmm.population.analysis import physiology as _core
 from ddmm.population.analysis.physiology import Property
+from ddmm.population.analysis.physiology_base import _spaced
 from ddmm.population.stimuli.scenes import Scene, Stage
 
 __all__ = ["PROPERTIES", "PROTOCOLS", "RUNNERS", "LOADING_RATES", "AMPLITUDES_N", "TRIALS", "MAX_UNITS",
@@ -113,12 +114,7 @@ def crossing_rate(fractions, level: float, rates=LOADING_RATES) -> float:
 
 def _units(population, kind: str):
     """At most `MAX_UNITS` afferents of ``kind``, evenly spaced in population order (None: none)."""
-    idx = np.flatnonzero(population.afferent_type == kind)
-    if idx.size == 0:
-        return None
-    if idx.size > MAX_UNITS:
-        idx = idx[np.linspace(0, idx.size - 1, MAX_UNITS).round().astype(np.int64)]
-    return population.select(idx)
+    return _spaced(population, (kind,), MAX_UNITS)
 
 
 def _simulate(population, scenes, context):

@@ -19,6 +19,9 @@ adds to its response to the normal load and load against it subtracts
   direction (SA-I, SA-II on the plateau 0.6-1.4 s; FA-I as counts in the
   loading ramp and 0.1 s after it), and for SA-I the fraction silenced in
   its worst direction.
+At most `MAX_UNITS` afferents of each type are simulated (evenly spaced in
+the population's order), so the hand costs what the fingertip does.
+
 * ``tilt_variant``: the same at 2 N normal, a 30 deg tilt toward 8
   directions, ramped at 10 N/s (no constant was set on it: a prediction).
 """
@@ -29,14 +32,16 @@ import numpy as np
 
 from ddmm.population.analysis import physiology as _core
 from ddmm.population.analysis.physiology import Property, _run
+from ddmm.population.analysis.physiology_base import _spaced
 from ddmm.population.stimuli.scenes import Scene
 
-__all__ = ["PROPERTIES", "PROTOCOLS", "RUNNERS", "tilt_scene", "tilt_fractions", "tilt_table", "TILT_DEG",
-           "DIRECTIONS", "TRIALS"]
+__all__ = ["DIRECTIONS", "MAX_UNITS", "PROPERTIES", "PROTOCOLS", "RUNNERS", "TILT_DEG", "TRIALS", "tilt_fractions",
+           "tilt_scene", "tilt_table"]
 
 TILT_DEG = 20.0
 DIRECTIONS = 12
 TRIALS = 3
+MAX_UNITS = 300
 _FS = 1000.0
 _ONSET = 0.1  # s
 _PLATEAU = (0.6, 1.4)  # s
@@ -65,7 +70,7 @@ def tilt_scene(normal_n: float, tilt_deg: float, direction_deg: float, rate_n_s:
     >>> round(float(s.fy[-1]), 3), round(float(s.fz[-1]), 3)
     (1.456, 4.0)
     """
-    t = np.arange(int(round(duration * _FS))) / _FS
+    t = np.arange(round(duration * _FS)) / _FS
     ramp = np.clip((t - _ONSET) * rate_n_s / normal_n, 0.0, 1.0)
     tangential = normal_n * np.tan(np.deg2rad(tilt_deg)) * ramp
     angle = np.deg2rad(direction_deg)
@@ -120,12 +125,17 @@ def _responses(ds, window, n_conditions) -> np.ndarray:
 
 
 def tilt_table(population, context, normal_n: float = 4.0, tilt_deg: float = TILT_DEG,
-               directions: int = DIRECTIONS, rate_n_s: float = 20.0, trials: int = TRIALS) -> dict:
+               directions: int = DIRECTIONS, rate_n_s: float = 20.0, trials: int = TRIALS,
+               max_units: int | None = MAX_UNITS) -> dict:
     """`tilt_fractions` per type (SA-I, SA-II on the plateau; FA-I in the loading ramp) for one tilt protocol,
-    on spikes summed over ``trials``.
+    on spikes summed over ``trials``, over at most ``max_units`` afferents of each type (None: all).
 
     ``context`` as the scorecard's (``seed``, ``engine``, ``no_shear``).
     """
+    if max_units is not None:
+        population = _spaced(population, ("SAI", "SAII", "RAI"), max_units)
+        if population is None:
+            return {}
     angles = np.arange(directions) * 360.0 / directions
     scenes = [tilt_scene(normal_n, 0.0, 0.0, rate_n_s)] + [tilt_scene(normal_n, tilt_deg, a, rate_n_s)
                                                             for a in angles]

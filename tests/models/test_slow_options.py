@@ -83,7 +83,8 @@ def test_sai_current_falls_by_a_fraction_through_a_hold_at_every_force(force):
 
 def test_the_transient_is_a_band_pass_of_tau_times_the_slope():
     """On a ramp of slope a the two low-passes lag by a tau / 2 and a tau: ``transient (R - K)`` tends to
-    ``transient a tau``; on a constant it tends to 0, and with ``transient`` 0 nothing moves (bit for bit)."""
+    ``transient a tau``; on a constant it tends to 0, on a falling ramp it adds nothing (rectified), and with
+    ``transient`` 0 the form without it holds bit for bit."""
     fs, tau, a = 1000.0, 0.1, 5.0  # Hz, s, mV/ms per s
     x = a * np.arange(3000) / fs
     states = [np.zeros(1) for _ in range(3)]
@@ -92,6 +93,10 @@ def test_the_transient_is_a_band_pass_of_tau_times_the_slope():
     assert out[-1] - x[-1] == pytest.approx(2.0 * a * tau, rel=0.02)
     flat = dynamic_kernel(np.full((3000, 1), 7.0), *[np.zeros(1) for _ in range(3)], *alphas, 0.0, 2.0, 0.0)
     assert flat[-1, 0] == pytest.approx(7.0, rel=1e-9)
+    falling = x[::-1].copy()  # unloading: rectified, the transient takes nothing away
+    states = [np.full(1, falling[0]) for _ in range(3)]
+    np.testing.assert_array_equal(dynamic_kernel(falling[:, None].copy(), *states, *alphas, 0.0, 2.0, 0.0)[:, 0],
+                                  falling)
     none = dynamic_kernel(x[:, None].copy(), *[np.zeros(1) for _ in range(3)], *alphas, 0.1, 0.0, 0.2)[:, 0]
     c, plain = 0.0, []
     for value in x:  # the form without the transient, written out

@@ -63,9 +63,9 @@ from ._pinned_digest import AFFERENTS, pinned_env
 #: (`transient_sai`, `adapt_sai` 1 -> 0.7).  With the presets of before (`BEFORE`, run from
 #: `_pinned_digest.BEFORE_PRESETS`) the code still gives the earlier digests, and this test holds it to them.
 RECORDED = {
-    "spikes": "3fe327cd43535e76fba15b67cbe6af8d7e1ea1bb7a3f8cbe72ca39d88480500e",
-    "n_spikes": 26325,
-    "currents": "85b23d990e1060c3c0c6d22aee097439eac3ec9ca136cd22dfd4aec5fac46139",
+    "spikes": "3028bfece619d2c9463dd24e1451fa6df75f114205f3248187f1b21fe8913ce5",
+    "n_spikes": 26392,
+    "currents": "1a4f9672c69722ac1c68023aad1e59b7dd19041bd48c2a921bb5f0f653a82d8c",
 }
 #: The digests of the presets before the SA-I transient and depth (the previous `RECORDED`).
 BEFORE = {
