@@ -111,3 +111,13 @@ def test_the_transient_raises_fast_loading_and_leaves_the_plateau():
     assert on[:130].max() > 1.3 * off[:130].max()  # a 30 N/s ramp: the transient's peak
     # gone within a few tau of the hold, but for tau times the slope of the hold's own slow fall (< 0.5%)
     np.testing.assert_allclose(on[-500:], off[-500:], rtol=5e-3)
+
+
+@pytest.mark.parametrize(("name", "value", "message"), [
+    ("transient_sai", -1.0, r"transient_sai must be a finite number >= 0, got -1\.0"),
+    ("transient_sai", float("nan"), r"transient_sai must be a finite number >= 0, got nan"),
+    ("tau_transient_sai_s", 0.0, r"tau_transient_sai_s must be a finite number > 0, got 0\.0"),
+])
+def test_bad_transient_is_refused(name, value, message):
+    with pytest.raises(ValueError, match=message):
+        CurrentParams(**{name: value})
