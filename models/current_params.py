@@ -257,8 +257,8 @@ class CurrentParams:
                 or not 0.0 <= self.phase_saii <= 1.0:
             raise ValueError(f"phase_saii must be a number in [0, 1], got {shown(self.phase_saii)}")
         for name in ("adapt_sai", "adapt_rai", "threshold_rai", "bias_saii", "opponent_saii", "normal_saii",
-                     "bias_cv_saii", "dynamic_sai", "transient_sai", "fall_sai", "excite_cv_sai", "excite_cv_rai", "excite_cv_raii",
-                     "excite_cv_saii", "shear_sai", "shear_rai", "shear_raii", "opponent_shear_sai",
+                     "bias_cv_saii", "dynamic_sai", "transient_sai", "fall_sai", "excite_cv_sai", "excite_cv_rai",
+                     "excite_cv_raii", "excite_cv_saii", "shear_sai", "shear_rai", "shear_raii", "opponent_shear_sai",
                      "opponent_shear_rai", "opponent_shear_raii"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
