@@ -29,6 +29,7 @@ import warnings
 
 import numpy as np
 
+from ddmm.population.analysis.physiology_base import peak_rates, window_counts
 from ddmm.population.analysis.physiology_tilt import DIRECTIONS, TILT_DEG, tilt_scene
 from ddmm.population.analysis.physiology_tilt import tilt_table as _tilt_table
 
@@ -67,15 +68,11 @@ def peak_table(population, forces_n=(2.0, 4.0), rates_n_s=LOADING_RATES, seed: i
     for force in forces_n:
         for rate in rates_n_s:
             ds = _simulate(population, tilt_scene(force, 0.0, 0.0, rate, duration=2.0), seed)
-            t, who = ds.spike_time.values, ds.spike_afferent.values
-            peaks, plateaus = [], []
-            for unit in sai:
-                times = np.sort(t[who == unit])
-                if times.size >= 3:
-                    peaks.append(1.0 / np.diff(times).min())
-                    plateaus.append(np.sum((times >= _PEAK_PLATEAU[0]) & (times < _PEAK_PLATEAU[1]))
-                                    / (_PEAK_PLATEAU[1] - _PEAK_PLATEAU[0]))
-            table[f"{force:g} N at {rate:g} N/s"] = {"units": len(peaks), "median_peak": float(np.median(peaks)),
+            fired = window_counts(ds, 0, (0.0, np.inf))[0][sai] >= 3
+            peaks = peak_rates(ds, 0, 0.0, np.inf)[sai][fired]
+            plateaus = (window_counts(ds, 0, _PEAK_PLATEAU)[0][sai][fired]
+                        / (_PEAK_PLATEAU[1] - _PEAK_PLATEAU[0]))
+            table[f"{force:g} N at {rate:g} N/s"] = {"units": int(fired.sum()), "median_peak": float(np.median(peaks)),
                                                     "median_plateau": float(np.median(plateaus))}
     return table
 

@@ -5,7 +5,9 @@ Every protocol module (`physiology_core` and the extensions that
 its rows with `Property` (``_p`` pairs a name with one) and runs its scenes
 through the same helpers: ``_knots`` (a normal-force scene through knots),
 ``_run`` (`ddmm.population.simulate` with the scorecard's seed and engine),
-``_rates`` (mean rate per afferent in a window) and ``_of`` (a type's mask).
+``_rates`` (mean rate per afferent in a window), ``_of`` (a type's mask), ``_spaced`` (at most
+so many afferents a type), `window_counts` (spikes per trial and afferent in a window) and
+`peak_rates` (each afferent's largest 1/ISI in a window).
 `ddmm.population.analysis.physiology` re-exports them all.
 """
 
@@ -17,7 +19,7 @@ import numpy as np
 
 from ddmm.population.stimuli.scenes import Scene
 
-__all__ = ["Property"]
+__all__ = ["Property", "peak_rates", "window_counts"]
 
 
 @dataclass(frozen=True)
@@ -61,6 +63,39 @@ def _spaced(population, kinds, max_units: int):
         keep.append(idx)
     keep = np.sort(np.concatenate(keep)) if keep else np.zeros(0, np.int64)
     return population.select(keep) if keep.size else None
+
+
+def window_counts(ds, condition: int, window) -> np.ndarray:
+    """Spikes per (trial, afferent) of one condition in ``window`` (s)."""
+    t = ds.spike_time.values
+    keep = (ds.spike_condition.values == condition) & (t >= window[0]) & (t < window[1])
+    n_aff, n_trial = ds.sizes["afferent"], ds.sizes["trial"]
+    flat = ds.spike_trial.values[keep] * n_aff + ds.spike_afferent.values[keep]
+    return np.bincount(flat, minlength=n_trial * n_aff).reshape(n_trial, n_aff)
+
+
+def peak_rates(ds, condition: int, t0: float, t1: float) -> np.ndarray:
+    """Each afferent's largest instantaneous rate 1/ISI (1/s) among its trial-0 spikes of one condition in
+    [t0, t1) s (0 with fewer than two spikes there).
+
+    Examples
+    --------
+    >>> import numpy as np, xarray as xr
+    >>> ds = xr.Dataset({"spike_time": ("spike", [0.10, 0.11, 0.30, 0.5]), "spike_afferent": ("spike", [0, 0, 0, 1]),
+    ...                  "spike_condition": ("spike", [0, 0, 0, 0]), "spike_trial": ("spike", [0, 0, 0, 0])},
+    ...                 coords={"afferent": [0, 1]})
+    >>> peak_rates(ds, 0, 0.0, 1.0).round(1).tolist()
+    [100.0, 0.0]
+    """
+    keep = (ds.spike_condition.values == condition) & (ds.spike_trial.values == 0) \
+        & (ds.spike_time.values >= t0) & (ds.spike_time.values < t1)
+    aff, t = ds.spike_afferent.values[keep], ds.spike_time.values[keep]
+    order = np.lexsort((t, aff))
+    aff, t = aff[order], t[order]
+    same = aff[1:] == aff[:-1]
+    peak = np.zeros(ds.sizes["afferent"])
+    np.maximum.at(peak, aff[1:][same], 1.0 / np.diff(t)[same])
+    return peak
 
 
 def _of(ds, kind):

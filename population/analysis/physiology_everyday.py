@@ -30,7 +30,7 @@ import numpy as np
 
 from ddmm.population.analysis import physiology as _core
 from ddmm.population.analysis.physiology import Property
-from ddmm.population.analysis.physiology_base import _spaced
+from ddmm.population.analysis.physiology_base import _spaced, window_counts
 from ddmm.population.stimuli.scenes import Scene, Stage
 
 __all__ = ["PROPERTIES", "PROTOCOLS", "RUNNERS", "LOADING_RATES", "AMPLITUDES_N", "TRIALS", "MAX_UNITS",
@@ -82,15 +82,6 @@ def press_scene(on_rate: float, off_rate: float, force_n: float = _FORCE_N, hold
     stages = (Stage("loading", 0.2, t_hold), Stage("hold", t_hold, t_off), Stage("release", t_off, t_end))
     scene = Scene(zero, zero, fz, fs, f"press_{force_n:g}N_{on_rate:g}_{off_rate:g}_{hold_s:g}s", stages)
     return scene, {"on": (0.2, round(t_hold + 0.1, 9)), "off": (round(t_off, 9), round(t_end + 0.1, 9))}
-
-
-def window_counts(ds, condition: int, window) -> np.ndarray:
-    """Spikes per (trial, afferent) of one condition in ``window`` (s)."""
-    t = ds.spike_time.values
-    keep = (ds.spike_condition.values == condition) & (t >= window[0]) & (t < window[1])
-    n_aff, n_trial = ds.sizes["afferent"], ds.sizes["trial"]
-    flat = ds.spike_trial.values[keep] * n_aff + ds.spike_afferent.values[keep]
-    return np.bincount(flat, minlength=n_trial * n_aff).reshape(n_trial, n_aff)
 
 
 def fires(counts) -> np.ndarray:

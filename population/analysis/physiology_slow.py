@@ -28,6 +28,7 @@ import numpy as np
 
 from ddmm.population.analysis import physiology as _core
 from ddmm.population.analysis.physiology import Property, _knots, _of, _rates
+from ddmm.population.analysis.physiology_base import peak_rates
 
 __all__ = ["PROPERTIES", "PROTOCOLS", "RUNNERS", "hold_scene"]
 
@@ -118,14 +119,7 @@ def _peaks(ds, condition, force, rate):
     top = _ONSET + force / rate
     sa = np.flatnonzero(_of(ds, "SAI"))
     plateau = _rates(ds, top + _HOLD - 1.0, top + _HOLD, condition)[sa]
-    keep = (ds.spike_condition.values == condition) & (ds.spike_trial.values == 0) \
-        & (ds.spike_time.values >= _ONSET) & (ds.spike_time.values < top + 0.1)
-    aff, t = ds.spike_afferent.values[keep], ds.spike_time.values[keep]
-    order = np.lexsort((t, aff))
-    aff, t = aff[order], t[order]
-    same = aff[1:] == aff[:-1]
-    peak = np.zeros(ds.sizes["afferent"])
-    np.maximum.at(peak, aff[1:][same], 1.0 / np.diff(t)[same])
+    peak = peak_rates(ds, condition, _ONSET, top + 0.1)
     ok = plateau > 0
     return peak[sa][ok], plateau[ok]
 

@@ -32,7 +32,7 @@ import numpy as np
 
 from ddmm.population.analysis import physiology as _core
 from ddmm.population.analysis.physiology import Property, _run
-from ddmm.population.analysis.physiology_base import _spaced
+from ddmm.population.analysis.physiology_base import _spaced, window_counts
 from ddmm.population.stimuli.scenes import Scene
 
 __all__ = ["DIRECTIONS", "MAX_UNITS", "PROPERTIES", "PROTOCOLS", "RUNNERS", "TILT_DEG", "TRIALS", "tilt_fractions",
@@ -116,14 +116,6 @@ def tilt_fractions(normal_only, tilted) -> dict:
             "median_worst_over_normal": float(np.median(r.min(axis=0) / b))}
 
 
-def _responses(ds, window, n_conditions) -> np.ndarray:
-    """Spikes per (condition, afferent) in ``window`` (s), summed over trials."""
-    t = ds.spike_time.values
-    keep = (t >= window[0]) & (t < window[1])
-    flat = ds.spike_condition.values[keep] * ds.sizes["afferent"] + ds.spike_afferent.values[keep]
-    return np.bincount(flat, minlength=n_conditions * ds.sizes["afferent"]).reshape(n_conditions, -1)
-
-
 def tilt_table(population, context, normal_n: float = 4.0, tilt_deg: float = TILT_DEG,
                directions: int = DIRECTIONS, rate_n_s: float = 20.0, trials: int = TRIALS,
                max_units: int | None = MAX_UNITS) -> dict:
@@ -145,7 +137,8 @@ def tilt_table(population, context, normal_n: float = 4.0, tilt_deg: float = TIL
     table = {}
     for kind, window in (("SAI", _PLATEAU), ("SAII", _PLATEAU), ("RAI", ramp)):
         if np.any(kinds == kind):
-            counts = _responses(ds, window, len(scenes))[:, kinds == kind]
+            counts = np.array([window_counts(ds, c, window).sum(axis=0) for c in range(len(scenes))])
+            counts = counts[:, kinds == kind]  # spikes per (condition, afferent), summed over trials
             table[kind] = tilt_fractions(counts[0], counts[1:])
     return table
 

@@ -220,14 +220,18 @@ def _of_type(afferent_type, types) -> np.ndarray:
 
 def _shallow(pop, sel):
     """Whether each afferent's type keeps part of its normal drive at AF = 0 (``CurrentParams.depth_<type>`` < 1)."""
-    shallow = [t for t in AFFERENT_TYPES if t != "SAII" and pop.current.for_type(t).depth < 1.0]
-    return _of_type(pop.afferent_type[sel], shallow)
+    return _types_where(pop, sel, lambda st: st.depth < 1.0)
 
 
 def _shear_gained(pop, sel):
     """Whether each afferent's drive has a shear-magnitude term (``CurrentParams.shear_<type>`` > 0)."""
-    gained = [t for t in AFFERENT_TYPES if t != "SAII" and pop.current.for_type(t).shear > 0.0]
-    return _of_type(pop.afferent_type[sel], gained)
+    return _types_where(pop, sel, lambda st: st.shear > 0.0)
+
+
+def _types_where(pop, sel, holds):
+    """Whether each afferent's pressure type (not SA-II) has resolved current parameters for which ``holds``."""
+    types = [t for t in AFFERENT_TYPES if t != "SAII" and holds(pop.current.for_type(t))]
+    return _of_type(pop.afferent_type[sel], types)
 
 
 def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
