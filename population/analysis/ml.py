@@ -341,7 +341,7 @@ class MaximumLikelihoodDecoder(_CircularDecoder):
 
 
 class FirstSpikeLatencyDecoder(_CircularDecoder):
-    """First-spike latencies matched to fitted latency curves (`decode.FirstSpikeLatency`'s math).
+    """First-spike latencies matched, as promptness, to fitted curves (`decode.FirstSpikeLatency`'s math).
 
     ``X`` holds latencies (``features(kind="latency")``, s, the window length
     for a silent afferent).  Fitting needs at least 10 samples over 5
@@ -355,9 +355,9 @@ class FirstSpikeLatencyDecoder(_CircularDecoder):
     Attributes
     ----------
     coef_ : ndarray, shape (5, n_afferents)
-        Latency curves (s) on (1, cos, sin, cos 2theta, sin 2theta).
+        Promptness curves (1/s, `decode.promptness` of the latency) on (1, cos, sin, cos 2theta, sin 2theta).
     sigma_ : ndarray, shape (n_afferents,)
-        Residual SD (s).
+        Residual SD of the promptness (1/s).
     usable_ : ndarray of bool, shape (n_afferents,)
         Afferents used to decode.
 

@@ -25,13 +25,9 @@ def test_every_property_has_a_reference_with_a_role():
     assert (best.role, best.low, best.high) == ("constrained", 200.0, 300.0)
 
 
-def test_fingertip_seed_0_passes_every_property_but_its_two_known_shortfalls(fingertip):
+def test_fingertip_seed_0_passes_every_property(fingertip):
     rows, _ = score_physiology(fingertip, PHYSIOLOGY_REFERENCE, seed=0)
-    # Known shortfalls on seed 0 (docs/validation.md): tuned_SAI 0.887 (< 0.89) and latency_vs_count 1.53
-    # (> 1.5). They must stay near their bounds; every other row must pass.
-    near = {"tuned_SAI": lambda v: v >= 0.87, "latency_vs_count": lambda v: v <= 1.65}
-    failing = [(r["name"], r["value"]) for r in rows if not r["pass"] and not near.get(r["name"], lambda v: 0)(r["value"])]
-    assert failing == []
+    assert [(r["name"], r["value"]) for r in rows if not r["pass"]] == []
     assert len(rows) == len(PROPERTIES)
 
 
