@@ -20,7 +20,8 @@ import json
 import resource
 import time
 
-__all__ = ["CASES", "EXTRA_CASES", "LSL_CASES", "SCALING", "SITE_BASELINES", "run_case", "run_extra"]
+__all__ = ["CASES", "EVENT_CASES", "EXTRA_CASES", "GROUPS", "LSL_CASES", "SCALING", "SITE_BASELINES", "run_case",
+           "run_extra"]
 
 #: name -> (population, engine, simulated seconds, warm-up?)
 CASES = {
@@ -39,6 +40,10 @@ EXTRA_CASES = ("scale_100k_inprocess", "scale_100k_2workers", "stream_fingertip"
 LSL_CASES = ("lsl_fingertip", "lsl_hand")
 #: ``--cases scaling``: afferents x simulated seconds, each in a fresh process.
 SCALING = tuple(f"scaling_{n}k_{t}s" for n in (1, 10, 100) for t in (1, 10))
+#: ``--cases events``: latency from the event (contact, release, shear) at 100 Hz, 1 kHz and 5 kHz, and over LSL.
+EVENT_CASES = ("events_100hz", "events_1khz", "events_5khz", "events_lsl")
+#: The groups ``--cases`` takes by name (a group is added here, and only here).
+GROUPS = {"scaling": SCALING, "lsl": LSL_CASES, "events": EVENT_CASES}
 #: Multi-site cases and the one-site case each is compared with (same population, same run).
 SITE_BASELINES = {"hand_5sites_1s_direct": "hand_1s_direct", "fingertip_16taxels_1s_direct": "fingertip_1s_direct"}
 DT = 1e-4
@@ -325,6 +330,9 @@ def run_extra(name: str) -> dict:
     if name in LSL_CASES:
         from ddmm.experiments.bench.lsl import run_lsl_case
         return run_lsl_case(name)
+    if name in EVENT_CASES:
+        from ddmm.experiments.bench.events import run_event_case
+        return run_event_case(name)
     if name in SCALING:
         return _scaling_case(name)
     if name in SITE_BASELINES:
@@ -346,12 +354,12 @@ def _cold_main(engine: str, out: str) -> None:
 
 if __name__ == "__main__":  # pragma: no cover - the per-case subprocess entries
     parser = argparse.ArgumentParser()
-    parser.add_argument("--case", choices=sorted([*CASES, *EXTRA_CASES, *SCALING, *LSL_CASES]))
+    parser.add_argument("--case", choices=sorted({*CASES, *EXTRA_CASES, *(n for g in GROUPS.values() for n in g)}))
     parser.add_argument("--cold", nargs=2, metavar=("ENGINE", "OUT"))
     cli_args = parser.parse_args()
     if cli_args.cold:
         _cold_main(*cli_args.cold)
-    elif cli_args.case in EXTRA_CASES or cli_args.case in SCALING or cli_args.case in LSL_CASES:
+    elif cli_args.case not in CASES:
         print(json.dumps(run_extra(cli_args.case)))
     else:
         print(json.dumps(run_case(cli_args.case)))

@@ -27,7 +27,7 @@ import uuid
 
 import numpy as np
 
-__all__ = ["run_lsl_case"]
+__all__ = ["run_lsl_case", "publish"]
 
 _FS = 1000.0
 _LOOPBACK = ("[ports]\nIPv6 = disable\n[multicast]\nResolveScope = machine\n[lab]\nKnownPeers = {127.0.0.1}\n"
@@ -101,26 +101,33 @@ def _over_lsl(population: str, forces):
         inlet = pylsl.StreamInlet(found[0], max_buflen=100_000)
         offset = float(read_spike_metadata(inlet.info(timeout=10.0))["input"]["clock_offset_s"])
         inlet.open_stream(timeout=10.0)
-        deadline = time.monotonic() + 60.0
-        while not outlet.have_consumers() and time.monotonic() < deadline:
-            time.sleep(0.01)
-        arrivals, stop = [], threading.Event()
-        reader = threading.Thread(target=_reader, args=(inlet, arrivals, stop))
-        reader.start()
-        pushed, t0 = np.empty(forces.shape[0]), pylsl.local_clock() + 0.05
-
-        def push(k):  # stamped with its due time, as a device's clock stamps samples; pushed when the loop gets to it
-            pushed[k] = pylsl.local_clock()
-            outlet.push_chunk(forces[k:k + 1], [t0 + k / _FS])
-            return 0.0
-        _paced(forces.shape[0], push)
-        time.sleep(1.0)
-        stop.set()
-        reader.join(10.0)
+        pushed, t0, arrivals = publish(pylsl, outlet, inlet, forces, _reader)
     finally:
         proc.terminate()
         proc.communicate(timeout=60)
     return pushed, t0 + offset, arrivals
+
+
+def publish(pylsl, outlet, inlet, forces, reader):
+    """Once the bridge subscribes, publish ``forces`` one sample per ms on ``outlet`` while ``reader(inlet,
+    arrivals, stop)`` collects the spike stream in a thread: (push times, the first sample's stamp, arrivals)."""
+    deadline = time.monotonic() + 60.0
+    while not outlet.have_consumers() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    arrivals, stop = [], threading.Event()
+    thread = threading.Thread(target=reader, args=(inlet, arrivals, stop))
+    thread.start()
+    pushed, t0 = np.empty(forces.shape[0]), pylsl.local_clock() + 0.05
+
+    def push(k):  # stamped with its due time, as a device's clock stamps samples; pushed when the loop gets to it
+        pushed[k] = pylsl.local_clock()
+        outlet.push_chunk(forces[k:k + 1], [t0 + k / _FS])
+        return 0.0
+    _paced(forces.shape[0], push)
+    time.sleep(1.0)
+    stop.set()
+    thread.join(10.0)
+    return pushed, t0, arrivals
 
 
 def _latencies(pushed, anchor, arrivals) -> np.ndarray:

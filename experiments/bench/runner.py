@@ -18,7 +18,7 @@ import sys
 import tempfile
 import time
 
-from ddmm.experiments.bench.cases import CASES, DT, EXTRA_CASES, LSL_CASES, SCALING, SITE_BASELINES
+from ddmm.experiments.bench.cases import CASES, DT, EXTRA_CASES, GROUPS, SITE_BASELINES
 from ddmm.models.engines.registry import engine_names
 
 __all__ = ["run_bench", "format_table"]
@@ -58,11 +58,9 @@ def _cold_start(engine: str) -> tuple[dict, float]:
 
 
 def run_bench(cases=None) -> dict:
-    """All cases, each in a fresh process, plus the cold starts (``cases=["scaling"]``: the scaling table)."""
-    names = list(CASES) + list(EXTRA_CASES) if cases is None else list(cases)
-    if names in (["scaling"], ["lsl"]):
-        return {"cases": [_subprocess_case(n) for n in (SCALING if names == ["scaling"] else LSL_CASES)],
-                "ratios": {}, "one_time": {}}
+    """All cases, each in a fresh process, plus the cold starts; ``cases`` names cases or groups (`GROUPS`:
+    ``["scaling"]`` the scaling table, ``["events"]`` latency from the event), each group standing for its cases."""
+    names = list(CASES) + list(EXTRA_CASES) if cases is None else [n for c in cases for n in GROUPS.get(c, (c,))]
     results = [_subprocess_case(n) for n in names]
     one_time = {}
     for engine in engine_names() if cases is None else ():
@@ -85,32 +83,47 @@ def run_bench(cases=None) -> dict:
 
 
 def format_table(result: dict) -> str:
-    lines = ["| case | engine | afferents | sim (s) | wall (s) | afferent-s/s | peak RSS (MB) | notes |",
-             "|---|---|---|---|---|---|---|---|"]
+    """The printed result: the speed cases' table, each event case's own table (`events.format_event_case`),
+    then the ratios and one-time costs."""
+    from ddmm.experiments.bench.cases import EVENT_CASES
+    from ddmm.experiments.bench.events import format_event_case
+
+    speed = [c for c in result["cases"] if c["name"] not in EVENT_CASES]
+    lines = []
+    if speed or len(speed) == len(result["cases"]):
+        lines += ["| case | engine | afferents | sim (s) | wall (s) | afferent-s/s | peak RSS (MB) | notes |",
+                  "|---|---|---|---|---|---|---|---|"]
+        lines += [_row(c) for c in speed]
     for c in result["cases"]:
-        notes = []
-        if "median_ms" in c:
-            notes.append(f"per 1 ms chunk, real-time paced: median {c['median_ms']:.3f} ms, p99 {c['p99_ms']:.3f} ms; "
-                         f"back to back: {c['unpaced_median_ms']:.3f} / {c['unpaced_p99_ms']:.3f} ms")
-        if "electrodes" in c:
-            notes.append(f"per 1 ms chunk with {c['electrodes']} electrodes: median {c['stimulation_median_ms']:.3f} "
-                         f"ms, p99 {c['stimulation_p99_ms']:.3f} ms; the encoder alone {c['encoder_median_ms']:.3f} / "
-                         f"{c['encoder_p99_ms']:.3f} ms")
-        if "lsl_latency" in c:
-            lsl, own = c["lsl_latency"], c["in_process_spiking"]
-            notes.append(f"sample-to-spike over LSL: median {lsl.get('median_ms', float('nan')):.3f} ms, p99 "
-                         f"{lsl.get('p99_ms', float('nan')):.3f} ms, worst {lsl.get('max_ms', float('nan')):.2f} ms; "
-                         f"in-process push of the same samples: {own['median_ms']:.3f} / {own['p99_ms']:.3f} / "
-                         f"{own['max_ms']:.2f} ms ({c['spikes_over_lsl']:,} spikes)")
-        if "over_kernel" in c:
-            low, high = c["over_kernel_range"]
-            notes.append(f"integration kernel alone {c['kernel_s']:.3f} s; pipeline / kernel {c['over_kernel']:.2f} "
-                         f"(median of {c['timed_runs']} alternated pairs, {low:.2f}-{high:.2f})")
-        if "us_per_afferent_second" in c:
-            notes.append(f"{c['us_per_afferent_second']:.2f} us per afferent-second")
-        if "peak_rss_per_worker_mb" in c:
-            notes.append(f"{c['workers']} workers, peak {c['peak_rss_per_worker_mb']:.0f} MB per worker")
-        lines.append(f"| {c['name']} | {c['engine']} | {c['n_afferents']} | {c['sim_s']:g} | {c['wall_s']:.3f} "
-                     f"| {c['afferent_s_per_wall_s']:.0f} | {c['peak_rss_mb']:.0f} | {'; '.join(notes)} |")
+        if c["name"] in EVENT_CASES:
+            lines += ([""] if lines else []) + format_event_case(c)
     lines += [f"{k}: {v}" for k, v in {**result["ratios"], **result["one_time"]}.items()]
     return "\n".join(lines)
+
+
+def _row(c: dict) -> str:
+    """One speed case's row of the table."""
+    notes = []
+    if "median_ms" in c:
+        notes.append(f"per 1 ms chunk, real-time paced: median {c['median_ms']:.3f} ms, p99 {c['p99_ms']:.3f} ms; "
+                     f"back to back: {c['unpaced_median_ms']:.3f} / {c['unpaced_p99_ms']:.3f} ms")
+    if "electrodes" in c:
+        notes.append(f"per 1 ms chunk with {c['electrodes']} electrodes: median {c['stimulation_median_ms']:.3f} "
+                     f"ms, p99 {c['stimulation_p99_ms']:.3f} ms; the encoder alone {c['encoder_median_ms']:.3f} / "
+                     f"{c['encoder_p99_ms']:.3f} ms")
+    if "lsl_latency" in c:
+        lsl, own = c["lsl_latency"], c["in_process_spiking"]
+        notes.append(f"sample-to-spike over LSL: median {lsl.get('median_ms', float('nan')):.3f} ms, p99 "
+                     f"{lsl.get('p99_ms', float('nan')):.3f} ms, worst {lsl.get('max_ms', float('nan')):.2f} ms; "
+                     f"in-process push of the same samples: {own['median_ms']:.3f} / {own['p99_ms']:.3f} / "
+                     f"{own['max_ms']:.2f} ms ({c['spikes_over_lsl']:,} spikes)")
+    if "over_kernel" in c:
+        low, high = c["over_kernel_range"]
+        notes.append(f"integration kernel alone {c['kernel_s']:.3f} s; pipeline / kernel {c['over_kernel']:.2f} "
+                     f"(median of {c['timed_runs']} alternated pairs, {low:.2f}-{high:.2f})")
+    if "us_per_afferent_second" in c:
+        notes.append(f"{c['us_per_afferent_second']:.2f} us per afferent-second")
+    if "peak_rss_per_worker_mb" in c:
+        notes.append(f"{c['workers']} workers, peak {c['peak_rss_per_worker_mb']:.0f} MB per worker")
+    return (f"| {c['name']} | {c['engine']} | {c['n_afferents']} | {c['sim_s']:g} | {c['wall_s']:.3f} "
+            f"| {c['afferent_s_per_wall_s']:.0f} | {c['peak_rss_mb']:.0f} | {'; '.join(notes)} |")

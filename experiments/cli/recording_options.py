@@ -11,7 +11,7 @@ _CSV_ONLY = {"columns": None, "fs": None, "time_scale": 1.0, "negative_fz": "err
              "units": "N", "fz_sign": 1}
 # Conditioning field -> option attribute
 _CONDITIONING = {"noise_n": "sensor_noise", "bandwidth_hz": "bandwidth", "shear_hold_n": "shear_hold",
-                 "normal_hold_n": "normal_hold"}
+                 "normal_hold_n": "normal_hold", "adapt_noise": "adapt_noise"}
 
 
 def add_recording_options(p, *, stream: bool = False) -> None:
@@ -38,7 +38,10 @@ def add_recording_options(p, *, stream: bool = False) -> None:
                    help="the conditioning stage between the recording and the model (default causal; "
                         "zero_phase offline only; docs/recordings.md)")
     g.add_argument("--sensor-noise", type=float, default=None, metavar="N",
-                   help="the sensor's noise SD in newtons: the fast band is gated at 4x it (default 0.02; 0: off)")
+                   help="the sensor's noise SD in newtons, at most: the fast band is gated at 4x it, or at 4x five "
+                        "times the noise measured as the samples stream, whichever is smaller (default 0.02; 0: off)")
+    g.add_argument("--fixed-noise", dest="adapt_noise", action="store_const", const=False, default=None,
+                   help="condition for --sensor-noise always, not for the noise the samples show")
     g.add_argument("--bandwidth", type=float, default=None, metavar="HZ", help="the sensor's bandwidth in Hz")
     g.add_argument("--shear-hold", type=float, default=None, metavar="N",
                    help="the shear hold's least width in newtons: tangential force moves only beyond +- it, "
@@ -54,8 +57,8 @@ def conditioning_from_args(args):
 
     if args.conditioning == "off":
         if any(getattr(args, name) is not None for name in _CONDITIONING.values()):
-            raise ValueError("--sensor-noise, --bandwidth, --shear-hold and --normal-hold set the conditioning, "
-                             "which --conditioning off switches off")
+            raise ValueError("--sensor-noise, --fixed-noise, --bandwidth, --shear-hold and --normal-hold set the "
+                             "conditioning, which --conditioning off switches off")
         return None
     settings = {field: getattr(args, name) for field, name in _CONDITIONING.items() if getattr(args, name) is not None}
     return Conditioning(mode=args.conditioning, **settings)

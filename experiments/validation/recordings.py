@@ -1,7 +1,7 @@
 """``python -m ddmm.experiments.validation.recordings``: noisy force-plate-like recordings at 100 Hz-5 kHz through the
 conditioning stage and the fingertip preset: per-type rates per phase, silence in holds, sample-rate invariance.
 
-Two profiles, labelled as docs/recordings.md labels them:
+Four profiles, labelled as docs/recordings.md labels them:
 
 * ``press-push-lift`` (**constrained**): press to 3 N at 6 N/s, hold, push 1 N distal, hold, lift.  The
   conditioning's gate (4 x ``noise_n``), tracker bandwidth (5 Hz, then 4 Hz) and smoothing (twice the
@@ -11,6 +11,8 @@ Two profiles, labelled as docs/recordings.md labels them:
   looking at the holds of both profiles (five noise seeds, populations 0-4): constrained from there on.
 * ``slow-press`` (**held out**, run once after the hold's design): an everyday slow press to 3 N at
   2 N/s, 0.8 N of shear toward 120 deg at 1 N/s, a 2 s hold, release at 4 N/s.
+* ``tap-drag`` (**held out**, run once after the measured-noise design): a light tap to 1.5 N at 10 N/s,
+  0.6 N of shear toward 300 deg at 3 N/s, a 1 s hold, release at 8 N/s.
 
 Noise is white and Gaussian, the same SD on each axis at every sample rate (as a reader of the file sees it),
 and, for each profile, of the same density at every rate (a sensor read through an anti-aliasing filter).
@@ -34,6 +36,8 @@ PROFILES = {
                  [0, 0, 0, 0, -0.424, -0.424, 0, 0], [0, 0, 2, 2, 2, 2, 0, 0]), "held out"),
     "slow-press": (([0, 0.5, 2.0, 2.8, 3.6, 5.6, 6.35, 7.5], [0, 0, 0, 0, -0.4, -0.4, 0, 0],
                     [0, 0, 0, 0, 0.6928, 0.6928, 0, 0], [0, 0, 3, 3, 3, 3, 0, 0]), "held out"),
+    "tap-drag": (([0, 0.5, 0.65, 1.25, 1.45, 2.45, 2.6375, 3.6], [0, 0, 0, 0, 0.3, 0.3, 0, 0],
+                  [0, 0, 0, 0, -0.5196, -0.5196, 0, 0], [0, 0, 1.5, 1.5, 1.5, 1.5, 0, 0]), "held out"),
 }
 #: name -> phases (start, end) in s
 PHASES = {
@@ -43,6 +47,8 @@ PHASES = {
                 "hold2": (2.3, 3.4), "lift": (3.4, 3.7), "after": (4.0, 5.0)},
     "slow-press": {"rest": (0.1, 0.5), "press": (0.5, 2.0), "hold": (2.3, 2.8), "push": (2.8, 3.6),
                    "hold2": (3.9, 5.6), "lift": (5.6, 6.35), "after": (6.7, 7.5)},
+    "tap-drag": {"rest": (0.1, 0.5), "press": (0.5, 0.75), "hold": (0.95, 1.25), "push": (1.25, 1.45),
+                 "hold2": (1.75, 2.45), "lift": (2.45, 2.75), "after": (3.0, 3.6)},
 }
 RATES_HZ = (100.0, 250.0, 1000.0, 5000.0)
 TYPES = ("SAI", "RAI", "RAII", "SAII")
@@ -147,12 +153,16 @@ if __name__ == "__main__":  # pragma: no cover - a measurement, printed
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--holds", action="store_true",
-                        help="FA-I and FA-II in rest and holds: populations 0-4 x 5 noise seeds x 100, 250 Hz, 20 mN")
+                        help="FA-I and FA-II in rest and holds: populations 0-4 x 5 noise seeds x 100, 250 Hz")
+    parser.add_argument("--noise", type=float, default=0.02,
+                        help="--holds: the sensor noise SD in N (default 0.02, the declared noise: constrained; "
+                             "other levels held out)")
     args = parser.parse_args()
     if args.holds:
-        for kind, row in hold_sweep().items():
-            print(f"{kind} at rest and in holds (constrained): {row['above_0']} of {row['phase_rates']} phase-rates "
-                  f"above 0, largest {row['max']:.3f} pulses/s per afferent")
+        role = "constrained" if args.noise == 0.02 else "held out"
+        for kind, row in hold_sweep(noise_n=args.noise).items():
+            print(f"{kind} at rest and in holds, {args.noise * 1e3:g} mN ({role}): {row['above_0']} of "
+                  f"{row['phase_rates']} phase-rates above 0, largest {row['max']:.3f} pulses/s per afferent")
         raise SystemExit(0)
     out = run_check(seed=args.seed)
     if args.json:

@@ -14,7 +14,7 @@ from ddmm.utils.lazy import lazy_exports
 _WHERE = {
     "scenes": ("DEFAULT_FS", "Contact", "Scene", "Sites", "Stage", "birznieks", "press_push_lift",
                "rotating_shear", "taxel_radius"),
-    "recordings": ("from_csv", "RecordingBandWarning", "UNITS"),
+    "recordings": ("from_csv", "resample_unconditioned", "RecordingBandWarning", "UNITS"),
     "conditioning": ("Conditioning", "Conditioner", "condition_forces"),
     "site_scenes": ("contact_grid", "digit_tip_sites", "grasp", "incipient_slip", "torsion"),
 }

@@ -46,6 +46,15 @@ it, so a stream and an offline run give the same numbers, bit for bit):
    ``shear_deadband_n`` of its magnitude, so noise at zero shear cannot spin
    its direction.
 
+**The noise the sensor shows** (``adapt_noise``): ``noise_n`` is the most the
+stage expects.  The noise is measured as the samples stream (`noise_scale`:
+second differences, a percentile tracker), and a scale ``min(1, 6 measured /
+noise_n)`` multiplies the gate, the holds' widths, the part of
+``contact_on_n`` taken off F_Z and the hysteresis, and divides the tracker's
+and the smoothing's bandwidths: a sensor of ``noise_n / 6`` or more is
+conditioned as declared, a quiet one passes nearly as recorded, with no lag
+at contact and release.
+
 ``mode="zero_phase"`` (offline only) resamples by monotone cubic
 interpolation, runs both filters forwards and backwards and averages the
 shear hold run both ways: no lag, but not causal, so a stream cannot
@@ -59,7 +68,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.population.stimuli._conditioning_kernels import gate_hold_contact, hold_band, hold_counts, sos_filter
+from ddmm.population.stimuli._conditioning_kernels import (
+    gate_hold_contact,
+    hold_band,
+    hold_counts,
+    noise_scale,
+    smooth_band,
+    sos_filter,
+    track_band,
+)
 from ddmm.utils.validation import as_finite_array, check_positive
 
 __all__ = ["Conditioning", "Conditioner", "condition_forces", "noise_allowance", "CONDITIONING_MODES"]
@@ -77,6 +94,11 @@ _NARROW_S = 0.02
 # `hold_widths` entries that the normal hold (before the smoothing) and the shear hold (after it) each use.
 _NORMAL_ONLY = np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0])
 _SHEAR_ONLY = np.array([1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 0.0])
+# `track_noise`: the first estimate is the RMS of this many second differences (at least), over this long (s);
+# then the percentile tracker's time constant (s) and its fastest step (log); the estimate's margin; the time
+# constants (s) of the scale's rise and fall toward the tracker.
+_NOISE_FIRST, _NOISE_FIRST_S, _NOISE_TAU_S, _NOISE_STEP, _NOISE_MARGIN = 20, 0.02, 0.1, 0.05, 6.0
+_SCALE_RISE_S, _SCALE_FALL_S, _SCALE_SMOOTH_S = 0.05, 0.5, 0.02
 
 
 @dataclass(frozen=True)
@@ -113,6 +135,11 @@ class Conditioning:
     mode : {"causal", "zero_phase"}
         Causal filters (offline and streaming) or forward-backward ones
         (offline only).
+    adapt_noise : bool
+        Measure the sensor's noise as it streams and condition for the
+        smaller of it (times a margin) and ``noise_n`` (`track_noise`): a
+        quiet sensor passes nearly as recorded, with no lag at contact.
+        False: always ``noise_n``, as if the sensor were that noisy.
     """
 
     noise_n: float = 0.02
@@ -124,6 +151,7 @@ class Conditioning:
     shear_hold_n: float = 0.025
     normal_hold_n: float = 0.025
     mode: str = "causal"
+    adapt_noise: bool = True
 
     def __post_init__(self):
         for name in ("noise_n", "contact_off_n", "shear_deadband_n", "shear_hold_n", "normal_hold_n"):
@@ -133,6 +161,8 @@ class Conditioning:
                       f"> contact_off_n = {self.contact_off_n:g} (N)")
         if self.bandwidth_hz is not None:
             _check_number(self.bandwidth_hz, "bandwidth_hz", lambda x: x > 0.0, "> 0 (Hz) or None")
+        if not isinstance(self.adapt_noise, bool):
+            raise TypeError(f"adapt_noise must be True or False, got {self.adapt_noise!r}")
         if self.mode not in CONDITIONING_MODES:
             raise ValueError(f"mode={self.mode!r} is not allowed; allowed: {', '.join(CONDITIONING_MODES)}")
 
@@ -218,8 +248,12 @@ class Conditioner:
         # (a few % of it) still drives FA-II in a hold.  Lag here delays the signal; it opens no gate.
         self._sos_smooth = _lowpass(min(_SMOOTH * conditioning.slow_hz, 0.45 * self.fs_out), self.fs_out)
         self._k = 0  # input samples consumed
-        self._zi_rate = self._zi_slow = self._zi_smooth = None
+        self._zi_rate = None
+        self._slow_state = self._smooth_state = None  # `track_band`'s and `smooth_band`'s, from the first chunk
         self._contact = self._held = self._track = None
+        self._noise = None  # `track_noise`'s state, from the first chunk
+        self._noise_rates = _noise_rates(self.fs_in)
+        self._scale_gamma = 1.0 - math.exp(-1.0 / (_SCALE_SMOOTH_S * self.fs_out))
         self._moves = _hold_moves(conditioning, self.fs_out)
         self.widths = hold_widths(conditioning, *self._band_noise())
 
@@ -267,11 +301,29 @@ class Conditioner:
             setattr(self, which, zi)
         return sos_filter(sos, np.ascontiguousarray(x), zi)
 
-    def _resample(self, x):
+    def _counts(self, n: int) -> np.ndarray:
+        """Output samples each of the next ``n`` input samples covers: held (upsampling) or picked (0 or 1)."""
         if self._up:
-            held = np.repeat(x, hold_counts(self._k, x.shape[0], self.fs_out / self.fs_in), axis=0)
-            return self._filter(self._sos_rate, held, "_zi_rate")
-        return self._filter(self._sos_rate, x, "_zi_rate")[self._picks(x.shape[0])]
+            return hold_counts(self._k, n, self.fs_out / self.fs_in)
+        return np.bincount(self._picks(n), minlength=n).astype(np.int64)
+
+    def _resample(self, x, counts):
+        if self._up:
+            return self._filter(self._sos_rate, np.repeat(x, counts, axis=0), "_zi_rate")
+        return self._filter(self._sos_rate, x, "_zi_rate")[counts.astype(bool)]
+
+    def _noise_scale(self, x, counts):
+        """The noise scale (`noise_scale`) of the input samples ``x`` on the output grid (1: the declared noise)."""
+        s = self.settings
+        if not (s.adapt_noise and s.noise_n > 0):
+            return np.ones((int(counts.sum()), x.shape[1]))
+        if self._noise is None:
+            self._noise = np.zeros((7, x.shape[1]))
+            self._noise[2], self._noise[6] = -2.0, np.nan  # two samples before the first difference
+        # smoothed at the output rate: a scale held per input sample would step the offset and the hold's band
+        # (FA-II fired at 0.1-1 pulses/s in holds at 100 Hz and 5 mN on those steps)
+        return noise_scale(np.ascontiguousarray(x), s.noise_n, self._noise_rates, self._noise, counts,
+                           self._scale_gamma)
 
     def push(self, forces):
         """Condition the next chunk of recorded samples.
@@ -286,44 +338,56 @@ class Conditioner:
         """
         x = self._shape(forces)
         sites = x.shape[1] // 3
-        y = self._resample(x) if x.shape[0] else np.empty((0, x.shape[1]))
+        if x.shape[0] == 0:
+            return self._out(np.empty((0, x.shape[1])), np.empty((0, sites), bool))
+        counts = self._counts(x.shape[0])
+        scale = self._noise_scale(x, counts).reshape(-1, sites, 3)
+        y = self._resample(x, counts)
         self._k += x.shape[0]
         if y.shape[0] == 0:
             return self._out(y, np.empty((0, sites), bool))
         widths = self.widths
         if self.settings.noise_n > 0:
-            slow = self._filter(self._sos_slow, y, "_zi_slow")
-            # The normal hold acts before the smoothing, which rounds its corners: a corner of the held F_Z is
-            # a step of its velocity, and unsmoothed it drove FA-II in holds (0.3 pulses/s at 100 Hz, 20 mN).
-            # The shear hold stays after it (FA-I's shear term fired more in sheared holds the other way).
-            normal, shear = widths * _NORMAL_ONLY, widths * _SHEAR_ONLY
-            kept = self._filter(self._sos_smooth, self._hold(slow, y, normal), "_zi_smooth")
-            gate, widths = _GATE * self.settings.noise_n, shear
+            slow, kept = self._bands(y, scale.reshape(y.shape), widths * _NORMAL_ONLY)
+            gate, widths = _GATE * self.settings.noise_n, widths * _SHEAR_ONLY
         else:
             slow, kept, gate = y, y, -1.0
-        return self._out(*self._finish(y, slow, kept, gate, widths))
+        return self._out(*self._finish(y, slow, kept, gate, widths, scale))
 
-    def _hold(self, slow, y, widths):
+    def _bands(self, y, scale, normal):
+        """The tracker's slow band and the kept band (the normal hold, then the smoothing), both as wide as
+        the measured noise allows (`track_band`, `smooth_band`: the declared noise's bandwidths at scale 1)."""
+        cap, c = 0.45 * self.fs_out, self.settings
+        if self._slow_state is None:
+            self._slow_state, self._smooth_state = np.full((2, y.shape[1]), np.nan), np.full((2, y.shape[1]), np.nan)
+        slow = track_band(y, scale, c.slow_hz, cap, self.fs_out, self._slow_state)
+        # The normal hold acts before the smoothing, which rounds its corners: a corner of the held F_Z is
+        # a step of its velocity, and unsmoothed it drove FA-II in holds (0.3 pulses/s at 100 Hz, 20 mN).
+        # The shear hold stays after it (FA-I's shear term fired more in sheared holds the other way).
+        held = self._hold(slow, y, normal, scale.reshape(-1, y.shape[1] // 3, 3))
+        return slow, smooth_band(held, scale, _SMOOTH * c.slow_hz, cap, self.fs_out, self._smooth_state)
+
+    def _hold(self, slow, y, widths, scale):
         """The force hold (`hold_band`) on a copy of the tracker's slow band, its state carried over."""
         if widths[:3].max() <= 0.0:
             return slow
         sites = slow.shape[1] // 3
         self._start_hold(slow[0], sites)
         held = slow.reshape(slow.shape[0], sites, 3).copy()
-        hold_band(held, y.reshape(held.shape), widths, self._moves, self._held, self._track)
+        hold_band(held, y.reshape(held.shape), widths, self._moves, self._held, self._track, scale)
         return held.reshape(slow.shape)
 
-    def _finish(self, y, slow, kept, gate, widths):
+    def _finish(self, y, slow, kept, gate, widths, scale):
         """Gate, force hold of ``widths`` N per axis, contact and deadband (`gate_hold_contact`), state carried
-        over."""
+        over; ``scale`` (n, sites, 3) is the noise scale per output sample."""
         s, sites = self.settings, y.shape[1] // 3
         if self._contact is None:
-            self._contact = np.zeros(sites, bool)
+            self._contact, self._taken = np.zeros(sites, bool), np.zeros(sites)
         self._start_hold(kept[0], sites)
         shape = (y.shape[0], sites, 3)
-        return gate_hold_contact(y.reshape(shape), slow.reshape(shape), kept.reshape(shape), gate,
-                                 widths, self._moves, self._held, self._track, s.contact_on_n, s.contact_off_n,
-                                 s.shear_deadband_n, self._contact)
+        return gate_hold_contact(y.reshape(shape), slow.reshape(shape), kept.reshape(shape), gate, widths,
+                                 self._moves, self._held, self._track, s.contact_on_n, s.contact_off_n,
+                                 s.shear_deadband_n, self._contact, self._taken, np.ascontiguousarray(scale))
 
     def _start_hold(self, first, sites):
         """The hold's state, from the first sample it sees (a copy: the hold updates it in place)."""
@@ -366,32 +430,9 @@ def condition_forces(forces, fs_in: float, fs_out: float, conditioning: Conditio
     n_sites = None if forces.ndim == 2 else forces.shape[1]
     if conditioning.mode == "causal":
         return Conditioner(conditioning, fs_in, fs_out, n_sites).push(forces)
-    return _zero_phase(forces, fs_in, fs_out, conditioning, n_sites)
+    from ddmm.population.stimuli._zero_phase import zero_phase
 
-
-def _zero_phase(forces, fs_in, fs_out, conditioning, n_sites):
-    from scipy.interpolate import PchipInterpolator
-    from scipy.signal import sosfiltfilt
-
-    causal = Conditioner(Conditioning(**{**conditioning.__dict__, "mode": "causal"}), fs_in, fs_out, n_sites)
-    x = causal._shape(forces)
-    t_in = np.arange(x.shape[0]) / fs_in
-    t_out = np.arange(int(math.floor((x.shape[0] - 1) * fs_out / fs_in + 1e-9)) + 1) / fs_out
-    y = PchipInterpolator(t_in, x, axis=0)(t_out) if x.shape[0] > 2 else np.stack(
-        [np.interp(t_out, t_in, col) for col in x.T], axis=1)
-    padlen = min(y.shape[0] - 1, 3 * (2 * _ORDER + 1))
-    if conditioning.bandwidth_hz is not None and conditioning.bandwidth_hz < 0.45 * fs_out:
-        y = sosfiltfilt(_lowpass(conditioning.bandwidth_hz, fs_out), y, axis=0, padlen=padlen)
-    slow, kept, gate = y, y, -1.0
-    widths, moves = causal.widths, causal._moves  # the causal widths: the two-way filters' noise is no larger
-    if conditioning.noise_n > 0:
-        slow = sosfiltfilt(causal._sos_slow, y, axis=0, padlen=padlen)
-        held = _hold_both_ways(np.ascontiguousarray(slow), y, widths * _NORMAL_ONLY, moves)
-        kept, gate = sosfiltfilt(causal._sos_smooth, held, axis=0, padlen=padlen), _GATE * conditioning.noise_n
-        widths = widths * _SHEAR_ONLY
-    kept = _hold_both_ways(np.ascontiguousarray(kept), y, widths, moves)
-    return causal._out(*causal._finish(np.ascontiguousarray(y), np.ascontiguousarray(slow), kept, gate,
-                                       np.zeros(7)))
+    return zero_phase(forces, fs_in, fs_out, conditioning, n_sites)
 
 
 def hold_widths(conditioning: Conditioning, tracker_sd: float = 0.0, smooth_sd: float = 0.0) -> np.ndarray:
@@ -411,6 +452,14 @@ def hold_widths(conditioning: Conditioning, tracker_sd: float = 0.0, smooth_sd: 
     return np.array([shear, shear, normal, conditioning.contact_on_n, *floors])
 
 
+def _noise_rates(fs: float) -> np.ndarray:
+    """`track_noise`'s rates at an input rate ``fs`` Hz: the differences of its first estimate, the tracker's
+    step up (log; down a third of it) and the estimate's margin."""
+    first = max(_NOISE_FIRST, round(_NOISE_FIRST_S * fs))
+    return np.array([float(first), min(_NOISE_STEP, 3.0 / (_NOISE_TAU_S * fs)), _NOISE_MARGIN,
+                     min(1.0, 1.0 / (_SCALE_RISE_S * fs)), min(1.0, 1.0 / (_SCALE_FALL_S * fs))])
+
+
 def _hold_moves(conditioning: Conditioning, fs: float) -> np.ndarray:
     """`hold_band`'s rates at ``fs`` Hz: the settling's approach per sample (a fraction: the slow band's
     smoothing frequency, so a ramp's end is rounded as that smoothing rounds it), the settling's length in
@@ -426,17 +475,3 @@ def _start_track(sites: int) -> np.ndarray:
     track = np.zeros((sites, 3, 4))
     track[:, :, 0] = np.inf
     return track
-
-
-def _hold_both_ways(kept, y, widths, moves):
-    """The force hold run forwards and backwards, averaged: no lag, constant on a hold, as the other filters here."""
-    if widths[:3].max() <= 0.0 or kept.shape[0] == 0:
-        return kept
-    shape = (kept.shape[0], kept.shape[1] // 3, 3)
-    forward, backward = kept.reshape(shape).copy(), kept[::-1].reshape(shape).copy()
-    ref = np.ascontiguousarray(y).reshape(shape)
-    hold_band(forward, ref, widths, moves, np.array(forward[0]), _start_track(shape[1]))  # copies: updated in place
-    hold_band(backward, np.ascontiguousarray(ref[::-1]), widths, moves, np.array(backward[0]), _start_track(shape[1]))
-    held = widths[:3] > 0.0
-    forward[..., held] = 0.5 * (forward[..., held] + backward[::-1][..., held])
-    return forward.reshape(kept.shape)

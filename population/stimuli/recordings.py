@@ -24,8 +24,8 @@ from ddmm.population.stimuli.scenes import DEFAULT_FS, MAX_FS, Contact, Scene
 from ddmm.utils.resources import check_memory
 from ddmm.utils.validation import check_positive, parse_number, shown
 
-__all__ = ["from_csv", "warn_band", "UNITS", "RECORDED", "RecordingBandWarning", "NEGATIVE_FZ", "GAPS",
-           "FA_II_MIN_FS"]
+__all__ = ["from_csv", "resample_unconditioned", "warn_band", "UNITS", "RECORDED", "RecordingBandWarning",
+           "NEGATIVE_FZ", "GAPS", "FA_II_MIN_FS"]
 
 #: Force units a file may be in, and their value in newtons.
 UNITS = {"N": 1.0, "mN": 1e-3, "gf": 9.80665e-3, "kgf": 9.80665, "lbf": 4.4482216152605}
@@ -221,7 +221,7 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
     check_memory(64.0 * n_out, f"scene file {str(path)!r} resampled to {fs:g} Hz ({n_out:,.0f} samples)",
                  "check its time column and --time-scale")
     if conditioning is None:
-        out = _pchip(forces, fs_in, fs)
+        out = resample_unconditioned(forces, fs_in, fs)
     else:
         out, _ = condition_forces(forces, fs_in, fs, conditioning)
     return Scene(out[:, 0], out[:, 1], out[:, 2], fs=fs, name=name or Path(path).stem, contact=contact)
@@ -248,8 +248,18 @@ def _check_options(fs, units, fz_sign, negative_fz, gaps, conditioning) -> None:
         raise TypeError(f"conditioning must be a Conditioning or None, got {type(conditioning).__name__}")
 
 
-def _pchip(forces, fs_in, fs):
-    """Monotone cubic resampling onto ``fs`` (no conditioning): it never overshoots, so F_Z stays >= 0."""
+def resample_unconditioned(forces, fs_in: float, fs: float) -> np.ndarray:
+    """Forces (n, 3) at ``fs_in`` Hz onto ``fs`` Hz as a recording reads with no conditioning (N).
+
+    Monotone cubic interpolation (offline: each output sample sees the next
+    input sample): it never overshoots, so F_Z stays >= 0.
+
+    Examples
+    --------
+    >>> out = resample_unconditioned(np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]]), 100.0, 1000.0)
+    >>> np.round(out[:, 2], 3).tolist()
+    [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]
+    """
     t = np.arange(forces.shape[0]) / fs_in
     grid = np.arange(int(math.floor(t[-1] * fs + 1e-9)) + 1) / fs
     if t.size < 3:

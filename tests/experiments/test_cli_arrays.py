@@ -114,7 +114,8 @@ def long_files(tmp_path, forces="time,site,fx,fy,fz\n0,a,0,0,1\n0,c,0,0,1\n"):
     (lambda p: ["--scene", save_array(p / "a.npz", pad_scene()), "--fz-sign", "-1"],
      "--fz-sign applies to a single-site .csv --scene"),
     (lambda p: ["--scene", save_array(p / "a.npz", pad_scene()), "--conditioning", "off", "--sensor-noise", "0.01"],
-     "--sensor-noise, --bandwidth, --shear-hold and --normal-hold set the conditioning, which --conditioning off switches off"),
+     "--sensor-noise, --fixed-noise, --bandwidth, --shear-hold and --normal-hold set the conditioning, which "
+     "--conditioning off switches off"),
     (lambda p: ["--scene", p / "a.mat"], "sensor-array file (.npz, .nc, .h5, .hdf5)"),
 ])
 def test_bad_array_scene_exit_2_nothing_written(capsys, tmp_path, make_args, match):

@@ -49,12 +49,14 @@ def test_the_shear_hold_option_reaches_the_conditioning():
     assert conditioning_from_args(parse(["simulate", "--out", "x.nc", "--shear-hold", "0"])).shear_hold_n == 0.0
     assert conditioning_from_args(parse(["simulate", "--out", "x.nc"])).shear_hold_n == 0.025
     assert conditioning_from_args(parse(["simulate", "--out", "x.nc", "--normal-hold", "0.01"])).normal_hold_n == 0.01
+    assert conditioning_from_args(parse(["simulate", "--out", "x.nc"])).adapt_noise is True
+    assert conditioning_from_args(parse(["simulate", "--out", "x.nc", "--fixed-noise"])).adapt_noise is False
 
 
 @pytest.mark.parametrize(("extra", "match"), [
     (["--columns", "tme=Time"], "--columns: 'tme=Time' is not NAME=COLUMN"),
-    (["--conditioning", "off", "--sensor-noise", "0.01"], "--sensor-noise, --bandwidth, --shear-hold and --normal-h"),
-    (["--conditioning", "off", "--shear-hold", "0"], "--sensor-noise, --bandwidth, --shear-hold and --normal-h"),
+    (["--conditioning", "off", "--sensor-noise", "0.01"], "--sensor-noise, --fixed-noise, --bandwidth, --shear-hold"),
+    (["--conditioning", "off", "--shear-hold", "0"], "--sensor-noise, --fixed-noise, --bandwidth, --shear-hold"),
     (["--normal-hold", "-1"], "normal_hold_n must be a finite number >= 0 \\(N\\), got -1"),
     (["--sensor-noise", "-1"], "noise_n must be a finite number >= 0"),
     (["--shear-hold", "-0.5"], "shear_hold_n must be a finite number >= 0 \\(N\\), got -0.5"),

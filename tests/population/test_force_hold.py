@@ -10,7 +10,9 @@ from scipy.signal import sosfilt
 from ddmm.population import Scene, sample_population, simulate
 from ddmm.population.stimuli.conditioning import Conditioner, Conditioning, condition_forces
 
-FREE = Conditioning(shear_hold_n=0.0, normal_hold_n=0.0)
+# Noise-free ramps read as a sensor of the declared noise (adapt_noise=False): how the hold moves at that noise.
+DECLARED = Conditioning(adapt_noise=False)
+FREE = Conditioning(shear_hold_n=0.0, normal_hold_n=0.0, adapt_noise=False)
 
 
 def ramp(fs, axis, slope, top=1.0, duration=3.0):
@@ -48,7 +50,7 @@ def test_a_ramp_lags_by_the_set_width_at_any_rate(fs_in):
     """A lasting drag narrows the band to its setting: at 100 Hz (band 41 mN) a 1 N/s shear ramp trails the
     unheld one by 25 mN in mid-ramp, as at 1 kHz."""
     f = ramp(fs_in, 1, 1.0)
-    held, free = (condition_forces(f, fs_in, 1000.0, c)[0][1500, 1] for c in (Conditioning(), FREE))
+    held, free = (condition_forces(f, fs_in, 1000.0, c)[0][1500, 1] for c in (DECLARED, FREE))
     assert free - held == pytest.approx(0.025, abs=5e-4)
 
 
@@ -59,7 +61,7 @@ def test_a_ramp_that_pauses_does_not_stall_on_the_full_width():
     t = np.arange(0, 3, 0.01)
     f = np.column_stack([0 * t, np.interp(t, [0, 1.0, 1.5, 1.6, 2.1, 3], [0, 0, 0.5, 0.5, 1.0, 1.0]),
                          np.full_like(t, 2.0)])
-    held, free = (condition_forces(f, 100.0, 1000.0, c)[0][:, 1] for c in (Conditioning(), FREE))
+    held, free = (condition_forces(f, 100.0, 1000.0, c)[0][:, 1] for c in (DECLARED, FREE))
     assert (free - held)[1600:1900].max() < 0.032
 
 
@@ -73,7 +75,7 @@ def test_after_a_ramp_the_hold_settles_on_the_input_and_then_keeps_still(fs_in, 
     f = ramp(fs_in, axis, slope, top)
     if axis == 2:
         f[:, 2] = np.interp(np.arange(f.shape[0]) / fs_in, [0, 1.0, 1.0 + top / slope, 3.0], [0, 0, top, top])
-    held = condition_forces(f, fs_in, 1000.0)[0][:, axis]
+    held = condition_forces(f, fs_in, 1000.0, DECLARED)[0][:, axis]
     after = int((1.0 + top / slope + 0.35) * 1000)
     assert np.abs(held[after:] - (top - 0.03)).max() < 5e-4
     assert np.abs(np.diff(held[after:])).max() * 1000.0 < 2e-3  # N/s: the tail of the tracker's settling
