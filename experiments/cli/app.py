@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import argparse
 import difflib
+import functools
 import os
 import re
 import sys
+import warnings
 
 __all__ = ["build_parser", "main"]
 
@@ -69,7 +71,10 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     debug = args.debug or os.environ.get("DDMM_DEBUG", "") not in ("", "0")
     try:
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("default")
+            warnings.showwarning = functools.partial(_show_warning, getattr(args, "types", None))
+            return int(args.func(args) or 0)
     except KeyboardInterrupt:
         print("ddmm: interrupted", file=sys.stderr)
         return 130
@@ -81,6 +86,21 @@ def main(argv=None) -> int:
             raise
         print(f"ddmm: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+
+
+def _show_warning(types, message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning as one ``ddmm: warning: ...`` line naming options, none once ``--types`` left out what it
+    concerns (never Python's ``file:line: Category: ...`` and a line of source)."""
+    from ddmm.utils.notices import cli_text, only_for_types
+
+    concerns = only_for_types(message)
+    if concerns and types is not None:
+        from ddmm.models.afferent_types import normalize_type
+
+        chosen = {normalize_type(t.strip(), "--types") for t in types.split(",") if t.strip()}
+        if not chosen & set(concerns):
+            return
+    print(f"ddmm: warning: {cli_text(message)}", file=sys.stderr)
 
 
 def _one_line(exc: BaseException) -> str:

@@ -7,6 +7,7 @@ a registered engine appears in every ``--engine`` option without an edit here.
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 from ddmm.experiments.cli.recording_options import (
@@ -47,7 +48,7 @@ def add_run_options(p, *, out_required: bool) -> None:
                    help="shear direction(s) in degrees, one condition each ('none': normal only); default 90")
     p.add_argument("--contact", default=None, metavar="X,Y,R", help="contact centre and radius in mm")
     add_engine_option(p, "brian2")
-    p.add_argument("--dt", type=float, default=None, metavar="MS", help="integration step in ms (default 0.1)")
+    p.add_argument("--dt", type=step_ms, default=None, metavar="MS", help="integration step in ms (default 0.1)")
     p.add_argument("--method", choices=("euler", "rk2", "rk4", "izhikevich2003"), default=None,
                    help="integration scheme (default euler)")
     p.add_argument("--tolerance", type=float, default=None, metavar="PPS",
@@ -62,6 +63,20 @@ def add_run_options(p, *, out_required: bool) -> None:
                    help="run afferent blocks on Dask: a local pool of processes or a scheduler address")
     p.add_argument("--out", required=out_required, metavar="FILE.nc")
     add_recording_options(p)
+
+
+def step_ms(text) -> float:
+    """An integration step in ms (``--dt``): a positive, finite number, refused in the option's own unit."""
+    import argparse
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number of ms, got {text!r}") from None
+    if not (math.isfinite(value) and value > 0.0):
+        raise argparse.ArgumentTypeError(f"must be a positive number of ms, got {text}")
+    return value
 
 
 def parse_directions(text, default="90"):
@@ -137,7 +152,16 @@ def scenes_from_args(args) -> list:
                              "forces")
         return [csv_scene(args.scene, args, contact)]
     raise ValueError(f"--scene {args.scene!r} is unknown; allowed: {', '.join(SCENES)}, a .csv file or a "
-                     f"sensor-array file ({', '.join(EXTENSIONS)})")
+                     f"sensor-array file ({', '.join(EXTENSIONS)}){_closest(args.scene.replace('_', '-'), SCENES)}")
+
+
+def _closest(word: str, names) -> str:
+    """`` (did you mean NAME?)`` for the name nearest ``word`` (the Dataset spells scenes press_push_lift_90)."""
+    import difflib
+
+    stem = re.sub(r"[-_]\d+$", "", word)  # a condition name's direction suffix
+    match = difflib.get_close_matches(stem, list(names), n=1, cutoff=0.6)
+    return f" (did you mean {match[0]}?)" if match else ""
 
 
 def parse_types(text):
@@ -148,6 +172,11 @@ def parse_types(text):
 def population_from_args(args):
     """The population of ``--population`` (a preset or a spec file), sampled with ``--seed``."""
     from ddmm.population import load_spec, sample_population
+    from ddmm.population.spec import PRESETS
+
+    if not str(args.population).endswith(".toml") and args.population not in PRESETS:
+        raise ValueError(f"--population {args.population!r} is neither a preset ({', '.join(PRESETS)}) nor a "
+                         f".toml file{_closest(str(args.population), PRESETS)}")
     return sample_population(load_spec(args.population), rng=args.seed)
 
 

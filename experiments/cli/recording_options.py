@@ -7,8 +7,8 @@ __all__ = ["add_recording_options", "conditioning_from_args", "csv_scene", "refu
 
 _FIELDS = ("time", "fx", "fy", "fz")
 # the single-site CSV reader's options and their defaults (a sensor-array file states its own)
-_CSV_ONLY = {"columns": None, "fs": None, "time_scale": 1.0, "negative_fz": "error", "gaps": "error",
-             "units": "N", "fz_sign": 1}
+_CSV_ONLY = {"columns": None, "fs": None, "time_scale": None, "negative_fz": "error", "gaps": "error",
+             "units": None, "fz_sign": 1}
 # Conditioning field -> option attribute
 _CONDITIONING = {"noise_n": "sensor_noise", "bandwidth_hz": "bandwidth", "shear_hold_n": "shear_hold",
                  "normal_hold_n": "normal_hold", "adapt_noise": "adapt_noise"}
@@ -24,14 +24,16 @@ def add_recording_options(p, *, stream: bool = False) -> None:
                        help="the file's column for each of time, fx, fy, fz (headers match in any case)")
         g.add_argument("--fs", type=float, default=None, metavar="HZ",
                        help="sample rate of a file without a time column")
-        g.add_argument("--time-scale", type=float, default=1.0, metavar="S",
-                       help="the time column's unit in seconds (0.001 for ms)")
+        g.add_argument("--time-scale", type=float, default=None, metavar="S",
+                       help="the time column's unit in seconds (0.001 for ms; default: the unit its header names, "
+                            "as in 'Time (ms)', else 1)")
         g.add_argument("--negative-fz", choices=NEGATIVE_FZ, default="error",
                        help="a negative normal force beyond sensor noise: an error (default), clipped, or the "
                             "first 0.1 s taken as the sensor's zero offset")
         g.add_argument("--gaps", choices=GAPS, default="error", help="gaps in the time column: refused or filled")
-    g.add_argument("--units", choices=tuple(UNITS), default=None if stream else "N",
-                   help="force unit of the input (default N" + ("; an LSL stream's declared unit)" if stream else ")"))
+    g.add_argument("--units", choices=tuple(UNITS), default=None,
+                   help="force unit of the input (default: " + ("an LSL stream's declared unit, else N)" if stream else
+                                                                "the unit the headers name, as in 'Fz (mN)', else N)"))
     g.add_argument("--fz-sign", type=int, choices=(1, -1), default=1,
                    help="-1 for a sensor that reports pressing as negative F_Z")
     g.add_argument("--conditioning", choices=("causal", "zero_phase", "off"), default="causal",

@@ -29,7 +29,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ddmm.experiments.cli.options import add_engine_option
+from ddmm.experiments.cli.options import add_engine_option, step_ms
 from ddmm.experiments.cli.recording_options import add_recording_options, conditioning_from_args
 from ddmm.experiments.io import seed_arg
 
@@ -42,7 +42,7 @@ def register(sub) -> None:
     p.add_argument("--population", default="fingertip")
     p.add_argument("--fs", type=float, default=None,
                    help="sample rate of the input in Hz (required on stdin; an LSL stream states its own)")
-    p.add_argument("--dt", type=float, default=0.1, metavar="MS")
+    p.add_argument("--dt", type=step_ms, default=0.1, metavar="MS", help="integration step in ms (default 0.1)")
     p.add_argument("--seed", type=seed_arg, default=0)
     add_engine_option(p, "direct")
     p.add_argument("--types", default=None, metavar="T[,T...]",

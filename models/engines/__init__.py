@@ -16,6 +16,7 @@ import numpy as np
 
 from ddmm.models.engines.registry import Engine, engine_names, get_engine, register_engine
 from ddmm.models.neuron import V_FLOOR, V_PEAK, NeuronParams, neuron_arrays, resting_state
+from ddmm.utils.notices import with_cli
 from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 
 __all__ = ["ENGINES", "Engine", "get_engine", "register_engine", "engine_names", "METHODS", "MAX_NEGATIVE_DRIVE_MV",
@@ -100,7 +101,8 @@ def substeps_for(fs: float, dt: float) -> int:
     n = int(round(ratio))
     if n < 1 or abs(ratio - n) > 1e-9 * max(1.0, ratio):
         raise ValueError(
-            f"dt={dt!r} s must divide the sample interval 1/fs = {1.0 / fs!r} s a whole number of times"
+            f"dt={dt:g} s ({dt * 1e3:g} ms) must divide the sample interval 1/fs = {1.0 / fs:g} s "
+            f"({1e3 / fs:g} ms) a whole number of times"
         )
     return n
 
@@ -253,6 +255,7 @@ def check_integration(neuron, step, v, u, current, method, dt, stacklevel=3) -> 
         consecutive = (np.diff(step[order]) == 1) & (np.diff(neuron[order]) == 0)
         if consecutive.any():
             n_capped = np.unique(neuron[order][1:][consecutive]).size
-            warnings.warn(SpikeCapWarning(
-                f"{n_capped} neuron(s) spiked on consecutive steps: the one-spike-per-step cap bound at "
-                f"dt={dt * 1e3:g} ms (rates up to {1.0 / dt:.0f} pulses/s); use a smaller dt"), stacklevel=stacklevel)
+            text = (f"{n_capped} neuron(s) spiked on consecutive steps: the one-spike-per-step cap bound at "
+                    f"dt={dt * 1e3:g} ms (rates up to {1.0 / dt:.0f} pulses/s)")
+            warnings.warn(with_cli(SpikeCapWarning(f"{text}; use a smaller dt"), f"{text}; use a smaller --dt (ms)"),
+                          stacklevel=stacklevel)

@@ -202,7 +202,7 @@ def track_noise(x, noise, rates, state):
     difference was out carry over.
     """
     n, c = x.shape
-    scale = np.ones((n, c))
+    scale = np.full((n, c), np.nan)  # NaN until the first estimate (`noise_scale` reads it as 1)
     floor = 1e-4 * noise
     for j in range(c):
         for i in range(n):
@@ -240,7 +240,8 @@ def noise_scale(x, noise, rates, state, counts, gamma):
     Input sample ``i`` covers ``counts[i]`` output samples (0 or 1 when
     downsampling); there a one-pole low-pass (``gamma`` of the way per
     output sample, its value in ``state[6]``, NaN before the first) smooths
-    the scale, and within 1e-9 of 1 it is 1: the declared noise exactly.
+    the scale from its first estimate on (1 before it), and within 1e-9 of 1
+    it is 1: the declared noise exactly.
     """
     scale = track_noise(x, noise, rates, state)
     n, c = x.shape
@@ -249,8 +250,11 @@ def noise_scale(x, noise, rates, state, counts, gamma):
         m, z = 0, state[6, j]
         for i in range(n):
             for _ in range(counts[i]):
-                z = scale[i, j] if np.isnan(z) else z + gamma * (scale[i, j] - z)
-                out[m, j] = 1.0 if z > 1.0 - 1e-9 else z
+                if np.isnan(scale[i, j]):  # no estimate yet: the declared noise
+                    out[m, j] = 1.0
+                else:  # smoothed from the first estimate on
+                    z = scale[i, j] if np.isnan(z) else z + gamma * (scale[i, j] - z)
+                    out[m, j] = 1.0 if z > 1.0 - 1e-9 else z
                 m += 1
         state[6, j] = z
     return out

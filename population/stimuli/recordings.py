@@ -19,8 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ddmm.population.stimuli._csv_header import TIME_UNITS, header_units, match_columns, split_unit
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.scenes import DEFAULT_FS, MAX_FS, Contact, Scene
+from ddmm.utils.notices import with_cli
 from ddmm.utils.resources import check_memory
 from ddmm.utils.validation import check_positive, parse_number, shown
 
@@ -48,7 +50,7 @@ class RecordingBandWarning(UserWarning):
 def _read(path, wanted: dict) -> tuple:
     """(the mapped columns as float arrays, the file's header): header names matched case-insensitively."""
     try:
-        with open(path, newline="", encoding="utf-8") as fh:
+        with open(path, newline="", encoding="utf-8-sig") as fh:  # a byte-order mark is not part of the header
             rows = [row for row in csv.reader(fh) if row and any(cell.strip() for cell in row)]
     except OSError as exc:
         raise ValueError(f"scene file {str(path)!r} cannot be read: {exc.strerror}") from None
@@ -57,13 +59,7 @@ def _read(path, wanted: dict) -> tuple:
     if not rows:
         raise ValueError(f"scene file {str(path)!r} is empty")
     header = [h.strip() for h in rows[0]]
-    lower = [h.lower() for h in header]
-    index = {}
-    for ours, theirs in wanted.items():
-        if theirs.lower() not in lower:
-            raise ValueError(f"scene file {str(path)!r} has no column {theirs!r} (for {ours}; matched "
-                             f"case-insensitively); header: {','.join(header)}")
-        index[ours] = lower.index(theirs.lower())
+    index = match_columns(path, header, wanted)
     if len(rows) < 2:
         raise ValueError(f"scene file {str(path)!r} has a header but no data rows")
     out = {k: np.empty(len(rows) - 1) for k in wanted}
@@ -80,7 +76,7 @@ def _read(path, wanted: dict) -> tuple:
             if not math.isfinite(out[ours][r - 2]):
                 raise ValueError(f"scene file {str(path)!r}: column {header[i]!r}, line {r}: {row[i]!r} is not "
                                  "finite")
-    return out, header
+    return out, header, header_units(header, index)
 
 
 def _mapping(columns, recorded_fs) -> dict:
@@ -138,7 +134,7 @@ def _negative(path, fz, forces, negative_fz, conditioning, fs_in):
 
 
 def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recorded_fs: float | None = None,
-             time_scale: float = 1.0, units: str = "N", force_scale: float = 1.0, fz_sign: int = 1,
+             time_scale: float | None = None, units: str | None = None, force_scale: float = 1.0, fz_sign: int = 1,
              negative_fz: str = "error", gaps: str = "error", conditioning: Conditioning | None = RECORDED,
              name: str | None = None, contact: Contact | None = None) -> Scene:
     """A scene from a recorded force file (a force plate, a load cell, a fingertip sensor).
@@ -147,7 +143,9 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
     ----------
     path : str or Path
         A CSV file with a header.  By default its columns are ``time, fx, fy,
-        fz`` (any case: ``Time,Fx,Fy,Fz`` reads as is).
+        fz`` in any case, with or without a unit: ``Time,Fx,Fy,Fz`` and
+        ``Time (ms),Fx [mN],...`` read as they are.  A UTF-8 byte-order mark
+        is skipped.
     columns : dict, optional
         Our names (``time``, ``fx``, ``fy``, ``fz``) to the file's, e.g.
         ``{"time": "t_ms", "fz": "Fz_N"}``.
@@ -155,10 +153,13 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
         Sample rate of the scene (the model's), Hz.
     recorded_fs : float, optional
         The recording's sample rate, Hz, for a file without a time column.
-    time_scale : float
-        The time column's unit in seconds (1e-3 for milliseconds).
-    units : {"N", "mN", "gf", "kgf", "lbf"}
-        The force columns' unit; ``force_scale`` multiplies further.
+    time_scale : float, optional
+        The time column's unit in seconds (1e-3 for milliseconds); default:
+        the unit its header names (s, ms, us), else 1.
+    units : {"N", "mN", "gf", "kgf", "lbf"}, optional
+        The force columns' unit; default: the unit their headers name, else
+        N.  One that contradicts a header is an error.  ``force_scale``
+        multiplies further.
     fz_sign : {1, -1}
         -1 for a plate that reports pressing as negative F_Z.
     negative_fz : {"error", "clip", "offset"}
@@ -194,14 +195,16 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
     >>> _ = path.write_text("Time,Fx,Fy,Fz\\n" + "".join(f"{k / 1000},0,0,{-min(k / 100, 2.0)}\\n"
     ...                                                   for k in range(1000)))
     >>> scene = from_csv(path, fz_sign=-1)
-    >>> scene.fs, round(float(scene.fz[-1]), 2)  # 2 N less the contact threshold (30 mN)
+    >>> scene.fs, round(float(scene.fz[-1]), 2)  # in contact from the start, before the noise is measured:
     (1000.0, 1.97)
+    >>> # ... 2 N less the contact threshold (30 mN), as for a sensor of the declared noise
     """
     _check_options(fs, units, fz_sign, negative_fz, gaps, conditioning)
     mapping = _mapping(columns, recorded_fs)
-    data, header = _read(path, mapping)
+    data, header, found = _read(path, mapping)
+    units, time_scale = _resolve_units(path, header, mapping, found, units, time_scale)
     if recorded_fs is not None:
-        if "time" in (h.lower() for h in header):
+        if "time" in (split_unit(h)[0].lower() for h in header):
             raise ValueError(f"scene file {str(path)!r} has a time column: give recorded_fs (--fs) only for a file "
                              "without one")
         fs_in = check_positive(recorded_fs, "recorded_fs", "Hz")
@@ -227,20 +230,60 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
     return Scene(out[:, 0], out[:, 1], out[:, 2], fs=fs, name=name or Path(path).stem, contact=contact)
 
 
+def _resolve_units(path, header, mapping, found, units, time_scale) -> tuple:
+    """(force unit, time scale in s): the headers' where they name one, the options' where given; a clash or
+    a unit we cannot read is an error naming the column and the option."""
+    by_lower = {u.lower(): u for u in UNITS}
+    named = {}
+    for ours in ("fx", "fy", "fz"):
+        unit = found.get(ours)
+        if unit is not None and unit.lower() not in by_lower:
+            raise ValueError(f"scene file {str(path)!r}: column {_column(header, mapping[ours])!r} is in {unit!r}, "
+                             f"not a force unit; allowed: {', '.join(UNITS)}")
+        if unit is not None:
+            named[by_lower[unit.lower()]] = ours
+    if len(named) > 1:
+        raise ValueError(f"scene file {str(path)!r}: the force columns name different units ({', '.join(named)})")
+    header_unit = next(iter(named), None)
+    if units is not None and header_unit not in (None, units):
+        raise ValueError(f"scene file {str(path)!r}: units={units!r} (--units {units}) but column "
+                         f"{_column(header, mapping[named[header_unit]])!r} is in {header_unit}; leave units out to "
+                         "read the header's")
+    return units or header_unit or "N", _time_scale(path, header, mapping, found.get("time"), time_scale)
+
+
+def _time_scale(path, header, mapping, unit, time_scale) -> float:
+    if unit is None:
+        return 1.0 if time_scale is None else time_scale
+    if unit.lower() not in TIME_UNITS:
+        raise ValueError(f"scene file {str(path)!r}: column {_column(header, mapping['time'])!r} is in {unit!r}, "
+                         f"not a time unit; allowed: {', '.join(TIME_UNITS)}")
+    scale = TIME_UNITS[unit.lower()]
+    if time_scale is not None and not math.isclose(time_scale, scale):
+        raise ValueError(f"scene file {str(path)!r}: time_scale={time_scale:g} (--time-scale {time_scale:g}) but "
+                         f"column {_column(header, mapping['time'])!r} is in {unit}; leave it out to read the header's")
+    return scale
+
+
+def _column(header, name: str) -> str:
+    """The header cell that ``name`` matched (with its unit)."""
+    return next((h for h in header if name.lower() in (h.lower(), split_unit(h)[0].lower())), name)
+
+
 def warn_band(what: str, fs_in: float, stacklevel: int = 4) -> None:
     """Warn (`RecordingBandWarning`) when a recording at ``fs_in`` Hz cannot carry FA-II's band."""
     if fs_in < FA_II_MIN_FS:
-        warnings.warn(RecordingBandWarning(
-            f"{what} is sampled at {fs_in:g} Hz and carries 0-{fs_in / 2:g} Hz: FA-II's band (up to 300 Hz) is "
-            "missing, so FA-II respond only to its ramps (leave them out with afferent_types=... or --types)"),
-        stacklevel=stacklevel)
+        text = (f"{what} is sampled at {fs_in:g} Hz and carries 0-{fs_in / 2:g} Hz: FA-II's band (up to 300 Hz) is "
+                "missing, so FA-II respond only to its ramps")
+        warnings.warn(with_cli(RecordingBandWarning(f"{text} (leave them out with afferent_types=...)"),
+                               f"{text} (leave them out: --types SAI,RAI,SAII)", ("RAII",)), stacklevel=stacklevel)
 
 
 def _check_options(fs, units, fz_sign, negative_fz, gaps, conditioning) -> None:
     check_positive(fs, "fs", "Hz")
     for value, name, allowed in ((units, "units", tuple(UNITS)), (negative_fz, "negative_fz", NEGATIVE_FZ),
                                  (gaps, "gaps", GAPS)):
-        if value not in allowed:
+        if value not in allowed and not (name == "units" and value is None):
             raise ValueError(f"{name}={value!r} is not allowed; allowed: {', '.join(allowed)}")
     if fz_sign not in (1, -1) or isinstance(fz_sign, bool):
         raise ValueError(f"fz_sign must be 1 or -1, got {shown(fz_sign)}")

@@ -71,3 +71,63 @@ def test_bad_recording_options_are_one_line(tmp_path, capsys, extra, match):
     assert code == 2 and len(err.splitlines()) == 1
     import re
     assert re.search(match, err), err
+
+
+def slow_plate(path):
+    """A 100 Hz plate: too slow for FA-II's band."""
+    t = np.arange(0, 1.0, 0.01)
+    fz = np.interp(t, [0, 0.3, 0.6, 1.0], [0, 0, 2, 2])
+    path.write_text("Time (s),Fx (N),Fy (N),Fz (N)\n" + "".join(f"{a:.2f},0,0,{b:.4f}\n" for a, b in zip(t, fz)))
+    return path
+
+
+@pytest.mark.parametrize(("types", "warned"), [(None, True), ("SAI,RAI,SAII", False), ("SA-I,FA-II", True)])
+def test_cli_warnings_are_one_line_naming_options_and_stop_when_followed(tmp_path, capsys, types, warned):
+    args = ["simulate", "--scene", str(slow_plate(tmp_path / "slow.csv")), "--engine", "direct", "--quiet",
+            "--population", "fingertip", "--out", str(tmp_path / "o.nc")] + (["--types", types] if types else [])
+    assert main(args) == 0
+    err = capsys.readouterr().err
+    assert ".py:" not in err and "Warning:" not in err  # never Python's file:line: Category: and a source line
+    lines = [line for line in err.splitlines() if line.startswith("ddmm: warning:")]
+    assert bool(lines) == warned
+    assert all("--types SAI,RAI,SAII" in line and "afferent_types" not in line for line in lines)
+
+
+def test_the_spike_cap_warning_names_the_dt_option_on_the_command_line():
+    from ddmm.models.engines import SpikeCapWarning, integrate
+    from ddmm.utils.notices import cli_text
+
+    with pytest.warns(SpikeCapWarning) as caught:
+        integrate(np.full((200, 1), 400.0), fs=1000.0, dt=1e-3, afferent_type=np.array(["RAII"]), engine="direct")
+    assert "use a smaller dt" in str(caught[0].message) and "use a smaller --dt (ms)" in cli_text(caught[0].message)
+
+
+@pytest.mark.parametrize(("dt", "match"), [("-1", "argument --dt: must be a positive number of ms, got -1"),
+                                           ("abc", "argument --dt: must be a number of ms, got 'abc'"),
+                                           ("2", r"\(2 ms\) must divide the sample interval .* \(1 ms\)")])
+def test_dt_is_answered_in_ms(tmp_path, capsys, dt, match):
+    import re
+
+    with pytest.raises(SystemExit) if dt != "2" else _no_exit():
+        code = main(["simulate", "--scene", "birznieks", "--quiet", "--dt", dt, "--out", str(tmp_path / "o.nc")])
+        assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and re.search(match, err), err
+
+
+def _no_exit():
+    import contextlib
+
+    return contextlib.nullcontext()
+
+
+@pytest.mark.parametrize(("extra", "match"), [
+    (["--population", "fingertips"], "'fingertips' is neither a preset .* \\(did you mean fingertip\\?\\)"),
+    (["--scene", "press_push_lift_90"], "--scene 'press_push_lift_90' is unknown.*\\(did you mean press-push-lift\\?\\)"),
+])
+def test_a_misspelt_population_or_scene_gets_a_did_you_mean(tmp_path, capsys, extra, match):
+    import re
+
+    assert main(["simulate", "--quiet", "--out", str(tmp_path / "o.nc"), *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and re.search(match, err), err
