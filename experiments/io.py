@@ -9,7 +9,11 @@ from pathlib import Path
 
 from ddmm.utils.files import atomic_write
 
-__all__ = ["ensure_out_dir", "atomic_write", "save_figure", "save_json", "seed_arg"]
+__all__ = ["ensure_out_dir", "atomic_write", "save_figure", "save_json", "seed_arg", "quiet_liblsl"]
+
+#: liblsl's configuration for a quiet run: fatal messages only (its INFO lines, and the "ERR| Stream
+#: transmission broke off" it prints when a peer closes at the end of a good run, are not the user's business).
+_QUIET_LSL = "[log]\nlevel = -3\n"
 
 
 def ensure_out_dir(path) -> Path:
@@ -53,3 +57,19 @@ def seed_arg(text: str) -> int:
     if value < 0:
         raise argparse.ArgumentTypeError(f"must be an integer >= 0 (a numpy seed), got {value}")
     return value
+
+
+def quiet_liblsl(debug: bool) -> None:
+    """Keep liblsl's log off the terminal (unless ``debug``, or ``LSLAPICFG`` names the user's own config).
+
+    Call before the first LSL stream opens: liblsl reads ``LSLAPICFG`` once.  The configuration is a
+    file in the temporary directory, written once.
+    """
+    import tempfile
+
+    if debug or "LSLAPICFG" in os.environ:
+        return
+    path = Path(tempfile.gettempdir()) / "ddmm-liblsl-quiet.cfg"
+    if not path.is_file() or path.read_text() != _QUIET_LSL:
+        atomic_write(path, lambda tmp: Path(tmp).write_text(_QUIET_LSL))
+    os.environ["LSLAPICFG"] = str(path)

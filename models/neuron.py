@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models.currents import AFFERENT_TYPES, normalize_type
+from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.utils.validation import shown
 
 __all__ = [

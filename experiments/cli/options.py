@@ -17,7 +17,7 @@ from ddmm.experiments.cli.recording_options import (
     refuse_csv_options,
 )
 from ddmm.experiments.io import seed_arg
-from ddmm.population.io.arrays import EXTENSIONS
+from ddmm.population.io.formats import EXTENSIONS
 
 __all__ = ["SCENES", "add_engine_option", "add_run_options", "check_out_file", "parse_contact", "parse_directions",
            "parse_types", "population_from_args", "scenes_from_args"]

@@ -31,7 +31,9 @@ def register(sub) -> None:
 
 
 def run_play(args) -> int:
+    from ddmm.experiments.io import quiet_liblsl
 
+    quiet_liblsl(getattr(args, "debug", False))  # before liblsl starts
     from ddmm.population import birznieks, press_push_lift, rotating_shear
     from ddmm.population.runtime.lsl import open_force_outlet
     from ddmm.population.runtime.lsl_bridge import play_forces

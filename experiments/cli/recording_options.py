@@ -16,7 +16,7 @@ _CONDITIONING = {"noise_n": "sensor_noise", "bandwidth_hz": "bandwidth", "shear_
 
 def add_recording_options(p, *, stream: bool = False) -> None:
     """Add the recording options to a subcommand's parser (the file-only ones unless ``stream``)."""
-    from ddmm.population.stimuli.recordings import GAPS, NEGATIVE_FZ, UNITS
+    from ddmm.population.stimuli.file_options import GAPS, NEGATIVE_FZ, UNITS
 
     g = p.add_argument_group("recorded forces" + ("" if stream else " (--scene FILE.csv)"))
     if not stream:

@@ -31,7 +31,7 @@ import numpy as np
 
 from ddmm.experiments.cli.options import add_engine_option, step_ms
 from ddmm.experiments.cli.recording_options import add_recording_options, conditioning_from_args
-from ddmm.experiments.io import seed_arg
+from ddmm.experiments.io import quiet_liblsl, seed_arg
 
 __all__ = ["register", "stop_on_signals", "stream"]
 
@@ -177,6 +177,8 @@ def run(args) -> int:
     if (args.electrodes is None) != (args.lsl_pulses is None) or (args.electrodes and args.lsl_in is None):
         raise ValueError("--electrodes and --lsl-pulses go together, with --lsl-in")
     sites = _sites(args.sites)
+    if args.lsl_in is not None or args.lsl_out is not None:
+        quiet_liblsl(getattr(args, "debug", False))
     if args.lsl_in is not None:
         return _run_lsl(args, sites)
     if args.fs is None:

@@ -69,6 +69,7 @@ from pathlib import Path
 import numpy as np
 
 from ddmm.population.io._long_csv import TIME_TOL, read_long_forces, read_sites_csv, uniform_grid
+from ddmm.population.io.formats import EXTENSIONS
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.recordings import RECORDED, warn_band
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Scene, Sites, taxel_radius
@@ -76,8 +77,6 @@ from ddmm.utils.files import atomic_write
 
 __all__ = ["EXTENSIONS", "from_array", "save_array", "from_long_csv", "default_radius"]
 
-#: File extensions `from_array` and `save_array` understand, by format.
-EXTENSIONS = {".npz": "npz", ".nc": "netcdf", ".h5": "hdf5", ".hdf5": "hdf5"}
 
 _REQUIRED = ("fs", "forces", "x_mm", "y_mm")
 _OPTIONAL = ("radius_mm", "region", "site")

@@ -9,8 +9,6 @@ import shlex
 __all__ = ["split_unit", "match_columns", "header_units"]
 
 _UNIT = re.compile(r"^(?P<name>.*?)\s*[(\[]\s*(?P<unit>[^)\]]*?)\s*[)\]]\s*$")
-#: Time units a header may name, in seconds.
-TIME_UNITS = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
 #: Other spellings of our column names, tried after the exact name.
 _ALIASES = {"time": ("t", "timestamp", "times", "time_s", "t_s"),
             "fx": ("force_x", "forcex", "f_x", "x"), "fy": ("force_y", "forcey", "f_y", "y"),

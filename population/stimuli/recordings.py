@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.population.stimuli._csv_header import TIME_UNITS, header_units, match_columns, split_unit
+from ddmm.population.stimuli._csv_header import header_units, match_columns, split_unit
+from ddmm.population.stimuli.file_options import GAPS, NEGATIVE_FZ, TIME_UNITS, UNITS
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.scenes import DEFAULT_FS, MAX_FS, Contact, Scene
 from ddmm.utils.notices import with_cli
@@ -29,12 +30,8 @@ from ddmm.utils.validation import check_positive, parse_number, shown
 __all__ = ["from_csv", "resample_unconditioned", "warn_band", "UNITS", "RECORDED", "RecordingBandWarning",
            "NEGATIVE_FZ", "GAPS", "FA_II_MIN_FS"]
 
-#: Force units a file may be in, and their value in newtons.
-UNITS = {"N": 1.0, "mN": 1e-3, "gf": 9.80665e-3, "kgf": 9.80665, "lbf": 4.4482216152605}
 #: The conditioning `from_csv` applies unless told otherwise.
 RECORDED = Conditioning()
-NEGATIVE_FZ = ("error", "clip", "offset")
-GAPS = ("error", "interpolate")
 #: A recording slower than this cannot carry FA-II's band (up to 300 Hz, sampled at 2.5x).
 FA_II_MIN_FS = 750.0
 _FIELDS = ("time", "fx", "fy", "fz")

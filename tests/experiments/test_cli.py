@@ -84,3 +84,23 @@ def test_plot_scaling_and_bench_case_names():
                         {"n_afferents": 1000, "sim_s": 10.0, "wall_s": 0.3}])
     assert len(fig.axes) == 2 and fig.axes[1].get_ylabel() == "us per afferent-second"
     assert main(["bench", "--cases", "nope"]) == 2
+
+
+def test_help_loads_no_numerical_stack():
+    """``ddmm --help`` (and a subcommand's) imports none of numba, xarray, brian2 or scipy: a fresh interpreter."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom ddmm.experiments.cli import main\n"
+            "for argv in (['--help'], ['simulate', '--help'], ['stream', '--help'], ['reproduce', '--help']):\n"
+            "    try:\n        main(argv)\n    except SystemExit:\n        pass\n"
+            "print(sorted(m for m in ('numba', 'xarray', 'brian2', 'scipy') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip().splitlines()[-1] == "[]"
+
+
+def test_the_reproduce_help_names_every_calibration():
+    from ddmm.experiments.cli.reproduce import CALIBRATION_NAMES
+    from ddmm.experiments.paper.calibrations import CALIBRATIONS
+
+    assert CALIBRATION_NAMES == tuple(CALIBRATIONS)

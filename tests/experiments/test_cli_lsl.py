@@ -196,3 +196,17 @@ def test_stream_publishes_stimulation_pulses_equal_to_the_in_process_encoder(tmp
     assert f"{expected.time.size:,} pulses out" in err and expected.time.size > 20
     np.testing.assert_array_equal(got[:, 0].astype(int), expected.electrode)
     np.testing.assert_array_equal(got[:, 1], expected.amplitude_ua)
+
+
+def test_liblsl_is_quiet_unless_debugging(monkeypatch):
+    """Without --debug (and without a config of the user's) liblsl gets a config that logs fatal errors only."""
+    from ddmm.experiments.io import quiet_liblsl
+
+    monkeypatch.delenv("LSLAPICFG", raising=False)
+    quiet_liblsl(True)
+    assert "LSLAPICFG" not in os.environ
+    quiet_liblsl(False)
+    assert Path(os.environ["LSLAPICFG"]).read_text() == "[log]\nlevel = -3\n"
+    monkeypatch.setenv("LSLAPICFG", "mine.cfg")
+    quiet_liblsl(False)
+    assert os.environ["LSLAPICFG"] == "mine.cfg"

@@ -1,0 +1,16 @@
+"""The choices a recorded force file's reader takes, in a module with no imports.
+
+`from_csv` and the sensor-array readers use them; the command line names them in its help without
+loading the stack (``ddmm --help`` imports no numba, scipy or xarray).
+"""
+
+__all__ = ["UNITS", "NEGATIVE_FZ", "GAPS", "TIME_UNITS"]
+
+#: Force units a file may be in, and their value in newtons.
+UNITS = {"N": 1.0, "mN": 1e-3, "gf": 9.80665e-3, "kgf": 9.80665, "lbf": 4.4482216152605}
+#: What to do with a negative normal force beyond sensor noise.
+NEGATIVE_FZ = ("error", "clip", "offset")
+#: What to do with a gap in the time column.
+GAPS = ("error", "interpolate")
+#: Time units a header may name, in seconds.
+TIME_UNITS = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
