@@ -37,6 +37,7 @@ import numba as nb
 import numpy as np
 import xarray as xr
 
+from ddmm.models.afferent_types import AFFERENT_TYPES, type_label
 from ddmm.models.attenuation import F_TH
 from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.models.neuron import NEURON_PARAMS, V_PEAK
@@ -372,7 +373,7 @@ def binned_rates(ds: xr.Dataset, bin_s: float, **kwargs) -> xr.DataArray:
 
 
 def psth(ds: xr.Dataset, bin_s: float = 0.01, *, by: str = "afferent_type") -> xr.DataArray:
-    """Peri-stimulus time histogram: mean rate (pulses/s) per condition, group and bin.
+    """Peri-stimulus time histogram: mean rate (imp/s) per condition, group and bin.
 
     Averages over trials and over the afferents of each value of ``by``
     (a coordinate on ``afferent``, e.g. ``"afferent_type"`` or ``"nap"``).
@@ -386,11 +387,15 @@ def describe_dataset(ds: xr.Dataset) -> str:
     lines = [f"population {ds.attrs.get('population')!r}: {ds.sizes['afferent']} afferents, "
              f"{ds.sizes['condition']} condition(s), {ds.sizes['trial']} trial(s)",
              f"engine {ds.attrs['engine']}, method {ds.attrs['method']}, dt {ds.attrs['dt'] * 1e3:g} ms, "
-             f"seed {ds.attrs['seed']}, no_shear {ds.attrs['no_shear']}, ddmm {ds.attrs['ddmm_version']}"]
+             f"seed {ds.attrs['seed']}, no_shear {ds.attrs['no_shear']} (eq. 17's reading below the shear "
+             f"threshold; docs/model.md), ddmm {ds.attrs['ddmm_version']}"]
+    present = set(ds.afferent_type.values.tolist())
+    kinds = [t for t in AFFERENT_TYPES if t in present]
     for c, name in enumerate(ds.condition.values):
         counts = ds.spike_count.isel(condition=c)
         dur = float(ds.duration[c])
-        parts = [f"{t}: {float(counts.where(ds.afferent_type == t, drop=True).mean()) / dur:.1f}"
-                 for t in np.unique(ds.afferent_type.values)]
-        lines.append(f"- {name} ({dur:g} s): {int(counts.sum())} spikes; mean rate (pulses/s) " + ", ".join(parts))
+        parts = [f"{type_label(t)} {float(counts.where(ds.afferent_type == t, drop=True).mean()) / dur:.1f}"
+                 for t in kinds]
+        lines.append(f"- {name} ({dur:g} s): {int(counts.sum())} spikes; mean rate per afferent (imp/s): "
+                     + ", ".join(parts))
     return "\n".join(lines)

@@ -28,7 +28,7 @@ def write_plots(ds, out_dir) -> list:
 
     out_dir = ensure_out_dir(out_dir)
     bin_s = max(0.005, float(ds.duration.max()) / 100.0)
-    figures = {"raster.png": plot_raster(ds), "psth.png": plot_psth(psth(ds, bin_s)),
+    figures = {"raster.png": plot_raster(ds), "psth.png": plot_psth(psth(ds, bin_s), ds),
                "polar.png": plot_polar_counts(ds), "forces.png": plot_forces(ds)}
     if "region" in ds.coords and any(ds.region.values.astype(str) != ""):  # afferents placed on the hand map
         from ddmm.experiments.plots.hand import hand_counts, plot_hand

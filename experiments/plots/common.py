@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from ddmm.models.afferent_types import AFFERENT_TYPES, PAPER_TYPES, type_label
 
@@ -39,7 +40,7 @@ def _plot_spikes(ax, spike_times, duration, bin_s, colour, label):
     top = max(1.0, rate.max() if rate.size else 1.0)
     ax.vlines(spike_times, 1.05 * top, 1.25 * top, color=colour, lw=0.6)
     ax.set_ylim(0, 1.3 * top)
-    ax.set_ylabel(f"{label}\n(pulses/s)", fontsize=8)
+    ax.set_ylabel(f"{label}\n(imp/s)", fontsize=8)
 
 
 def plot_response(data: dict, *, title: str = "", bin_s: float | None = None) -> Figure:
@@ -83,7 +84,7 @@ def plot_response(data: dict, *, title: str = "", bin_s: float | None = None) ->
 
 
 def plot_sf_vs_theta(sf: dict, *, title: str = "SF against tuning angle (Fig. 8)") -> Figure:
-    """SF (pulses/s) against theta_T for each profile and afferent type (paper Fig. 8).
+    """SF (imp/s) against θ_T for each profile and afferent type (paper Fig. 8).
 
     Parameters
     ----------
@@ -101,16 +102,16 @@ def plot_sf_vs_theta(sf: dict, *, title: str = "SF against tuning angle (Fig. 8)
             ax.plot(angles, values, "o-", ms=3, color=TYPE_COLOURS[kind], label=type_label(kind))
         ax.axvline(90.0, color="grey", ls=":", lw=1)
         ax.set_title(profile)
-        ax.set_xlabel("theta_T (deg)")
+        ax.set_xlabel("θ_T (deg)")
         ax.set_xticks(range(0, 361, 90))
-    axes[0].set_ylabel("SF (pulses/s)")
+    axes[0].set_ylabel("SF (imp/s)")
     axes[0].legend(fontsize=8)
     fig.suptitle(title)
     return fig
 
 
 def plot_raster(ds, *, condition=0, trial=0, max_afferents: int = 2000) -> Figure:
-    """Spike raster sorted by afferent type, then tuning angle theta_T.
+    """Spike raster sorted by afferent type, then tuning angle θ_T.
 
     Parameters
     ----------
@@ -138,10 +139,11 @@ def plot_raster(ds, *, condition=0, trial=0, max_afferents: int = 2000) -> Figur
         rows = row[(types == kind) & (row >= 0)]
         if rows.size:
             ax.axhline(rows.max() + 0.5, color="grey", lw=0.5)
-            ax.text(1.01, rows.mean(), kind, transform=ax.get_yaxis_transform(), va="center", color=TYPE_COLOURS[kind])
+            ax.text(1.01, rows.mean(), type_label(kind), transform=ax.get_yaxis_transform(), va="center",
+                    color=TYPE_COLOURS[kind])
     ax.set_xlim(0, float(ds.duration[condition]))
     ax.set_xlabel("time (s)")
-    ax.set_ylabel("afferent (by type, then theta_T)")
+    ax.set_ylabel("afferent (by type, then θ_T)")
     ax.set_title(f"raster: {ds.condition.values[condition]}, trial {trial}")
     return fig
 
@@ -154,17 +156,28 @@ def _label(group) -> str:
         return str(group)
 
 
-def plot_psth(rates) -> Figure:
-    """PSTH per afferent type: ``rates`` is `ddmm.population.psth` output (condition, type, bin)."""
-    groups = list(rates[rates.dims[1]].values)
-    fig = Figure(figsize=(8.0, 2.2 * len(groups)), layout="constrained")
-    axes = fig.subplots(len(groups), 1, sharex=True, squeeze=False)[:, 0]
-    for ax, group in zip(axes, groups):
+def plot_psth(rates, forces=None) -> Figure:
+    """PSTH per afferent type: ``rates`` is `ddmm.population.psth` output (condition, type, bin).
+
+    ``forces``, a simulation Dataset, adds its F_Z above the PSTH (per condition).
+    """
+    groups = sorted(rates[rates.dims[1]].values, key=lambda g: (AFFERENT_TYPES.index(g) if g in AFFERENT_TYPES
+                                                                else len(AFFERENT_TYPES), str(g)))
+    top = 1 if forces is not None else 0
+    fig = Figure(figsize=(8.0, 2.2 * (len(groups) + top)), layout="constrained")
+    axes = fig.subplots(len(groups) + top, 1, sharex=True, squeeze=False)[:, 0]
+    if top:
+        for c, name in enumerate(forces.condition.values):
+            axes[0].plot(forces.time.values, forces.fz.isel(condition=c).values, lw=1.0, label=str(name))
+        axes[0].set_ylabel("F_Z (N)")
+    for ax, group in zip(axes[top:], groups):
         for c, name in enumerate(rates.condition.values):
             ax.plot(rates.bin.values, rates.isel(condition=c).sel({rates.dims[1]: group}).values, lw=1.0, label=str(name))
-        ax.set_ylabel(f"{_label(group)}\n(pulses/s)")
+        ax.set_ylabel(f"{_label(group)}\n(imp/s)")
     axes[0].legend(fontsize=7)
     axes[-1].set_xlabel("time (s)")
+    bin_ms = float(rates.attrs.get("bin_s", np.nan)) * 1e3
+    fig.suptitle(f"PSTH: mean rate per afferent, {bin_ms:g} ms bins, mean over trials", fontsize=10)
     return fig
 
 
@@ -177,20 +190,22 @@ def plot_polar_counts(ds, *, condition=0) -> Figure:
         ax = fig.add_subplot(1, len(kinds), i + 1, projection="polar")
         sel = ds.afferent_type.values == kind
         ax.scatter(np.deg2rad(ds.theta_t.values[sel]), counts[sel], s=4, color=TYPE_COLOURS[kind])
-        ax.set_title(type_label(kind))
-    fig.suptitle(f"spike count against theta_T: {ds.condition.values[condition]}")
+        ax.yaxis.set_major_locator(MaxNLocator(3))  # a few radial ticks: they never run into each other
+        ax.tick_params(axis="y", labelsize=7)
+        ax.set_title(f"{type_label(kind)} (radius: spikes)")
+    fig.suptitle(f"spike count against θ_T: {ds.condition.values[condition]}")
     return fig
 
 
 def plot_forces(ds) -> Figure:
-    """The scene forces of every condition."""
+    """The forces of every condition as the model consumed them (a recording's: after its conditioning)."""
     n = ds.sizes["condition"]
     fig = Figure(figsize=(8.0, 2.0 * n), layout="constrained")
     axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
     for c, ax in enumerate(axes):
         forces = {name: ds[name].isel(condition=c).values for name in ("fx", "fy", "fz")}
         _plot_forces(ax, ds.time.values, forces)
-        ax.set_title(str(ds.condition.values[c]), fontsize=9)
+        ax.set_title(f"{ds.condition.values[c]}: the forces the model consumed", fontsize=9)
     axes[-1].set_xlabel("time (s)")
     return fig
 

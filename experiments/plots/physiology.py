@@ -24,7 +24,7 @@ def plot_rest(data: dict) -> Figure:
         ax.scatter(np.full(rate.size, i) + np.linspace(-0.3, 0.3, rate.size), rate, s=4,
                    color=TYPE_COLOURS[kind])
     ax.set_xticks(range(len(kinds)), kinds)
-    ax.set_ylabel("rate at rest (pulses/s)")
+    ax.set_ylabel("rate at rest (imp/s)")
     ax.set_title("rest: 60 s of zero force")
     return fig
 
@@ -43,7 +43,7 @@ def plot_on_off(data: dict, bin_s: float = 0.02) -> Figure:
         counts, _ = np.histogram(ds.spike_time.values[own], edges)
         ax.bar(edges[:-1], counts / bin_s / np.sum(ds.afferent_type.values == kind), width=bin_s, align="edge",
                color=TYPE_COLOURS[kind])
-        ax.set_ylabel(f"{kind}\n(pulses/s)", fontsize=8)
+        ax.set_ylabel(f"{type_label(kind)}\n(imp/s)", fontsize=8)
     axes[-1].set_xlabel("time (s)")
     return fig
 
@@ -55,12 +55,12 @@ def plot_force_coding(data: dict) -> Figure:
     if "sai_plateau" in data:
         a.plot([1, 2, 4], data["sai_plateau"], "o-", color=TYPE_COLOURS["SAI"])
     a.set_xlabel("normal force (N)")
-    a.set_ylabel("SA-I plateau rate (pulses/s)")
+    a.set_ylabel("SA-I plateau rate (imp/s)")
     if "rai_loading_rates" in data:
         b.set_yscale("log")
         _rate_axis(b, [2, 8, 32], np.maximum(data["rai_loading_rates"], 0.1))
     b.set_xlabel("force rate (N/s)")
-    b.set_ylabel("FA-I mean rate while loading (pulses/s)")
+    b.set_ylabel("FA-I mean rate while loading (imp/s)")
     return fig
 
 
