@@ -12,7 +12,8 @@ def register(sub) -> None:
     p = sub.add_parser("plot", help="raster, PSTH, polar and force figures of a dataset "
                                     "(and a spike-count hand map when its afferents carry hand-map regions)")
     p.add_argument("file")
-    p.add_argument("--out", required=True, metavar="DIR")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="where the figures go (default: FILE's name with -figures, beside it: run.nc -> run-figures)")
     p.set_defaults(func=run_plot)
 
 
@@ -38,7 +39,12 @@ def write_plots(ds, out_dir) -> list:
 
 
 def run_plot(args) -> int:
+    from pathlib import Path
+
     from ddmm.population import load_dataset
-    for path in write_plots(load_dataset(args.file), args.out):
+
+    source = Path(args.file)
+    out = args.out if args.out is not None else source.with_name(f"{source.stem}-figures")
+    for path in write_plots(load_dataset(args.file), out):
         print(f"wrote {path}")
     return 0

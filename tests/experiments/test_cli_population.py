@@ -29,6 +29,8 @@ def test_simulate_info_plot(capsys, tmp_path):
     assert code == 0
     assert {p.name for p in (tmp_path / "figs").iterdir()} == {"raster.png", "psth.png", "polar.png", "forces.png",
                                                              "hand.png"}  # the fingertip is D2d of the hand map
+    code, text, _ = run(capsys, "plot", out)  # no --out: beside the file, run.nc -> run-figures
+    assert code == 0 and {p.name for p in (tmp_path / "run-figures").iterdir()} >= {"raster.png", "psth.png"}
 
 
 def test_plan_prints_skips(capsys):
