@@ -6,7 +6,7 @@ import difflib
 import re
 import shlex
 
-__all__ = ["split_unit", "match_columns", "header_units"]
+__all__ = ["split_unit", "match_columns"]
 
 _UNIT = re.compile(r"^(?P<name>.*?)\s*[(\[]\s*(?P<unit>[^)\]]*?)\s*[)\]]\s*$")
 #: Other spellings of our column names, tried after the exact name.
@@ -78,8 +78,3 @@ def _guess(header, index, missing) -> dict:
             guess[ours] = header[hit].strip()
             free.remove(hit)
     return guess
-
-
-def header_units(header, index: dict) -> dict:
-    """Our name -> the unit its column's header names (None where it names none)."""
-    return {ours: split_unit(header[i])[1] for ours, i in index.items()}

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.population.stimuli._csv_header import header_units, match_columns, split_unit
+from ddmm.population.stimuli._csv_header import match_columns, split_unit
 from ddmm.population.stimuli.file_options import GAPS, NEGATIVE_FZ, TIME_UNITS, UNITS
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.scenes import DEFAULT_FS, MAX_FS, Contact, Scene
@@ -73,7 +73,7 @@ def _read(path, wanted: dict) -> tuple:
             if not math.isfinite(out[ours][r - 2]):
                 raise ValueError(f"scene file {str(path)!r}: column {header[i]!r}, line {r}: {row[i]!r} is not "
                                  "finite")
-    return out, header, header_units(header, index)
+    return out, header, {ours: header[i] for ours, i in index.items()}
 
 
 def _mapping(columns, recorded_fs) -> dict:
@@ -198,8 +198,8 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
     """
     _check_options(fs, units, fz_sign, negative_fz, gaps, conditioning)
     mapping = _mapping(columns, recorded_fs)
-    data, header, found = _read(path, mapping)
-    units, time_scale = _resolve_units(path, header, mapping, found, units, time_scale)
+    data, header, cells = _read(path, mapping)
+    units, time_scale = _resolve_units(path, cells, units, time_scale)
     if recorded_fs is not None:
         if "time" in (split_unit(h)[0].lower() for h in header):
             raise ValueError(f"scene file {str(path)!r} has a time column: give recorded_fs (--fs) only for a file "
@@ -227,16 +227,16 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
     return Scene(out[:, 0], out[:, 1], out[:, 2], fs=fs, name=name or Path(path).stem, contact=contact)
 
 
-def _resolve_units(path, header, mapping, found, units, time_scale) -> tuple:
-    """(force unit, time scale in s): the headers' where they name one, the options' where given; a clash or
-    a unit we cannot read is an error naming the column and the option."""
+def _resolve_units(path, cells: dict, units, time_scale) -> tuple:
+    """(force unit, time scale in s): the units the matched header ``cells`` name, the options' where given; a
+    clash or a unit we cannot read is an error naming the column and the option."""
     by_lower = {u.lower(): u for u in UNITS}
     named = {}
     for ours in ("fx", "fy", "fz"):
-        unit = found.get(ours)
+        unit = split_unit(cells[ours])[1]
         if unit is not None and unit.lower() not in by_lower:
-            raise ValueError(f"scene file {str(path)!r}: column {_column(header, mapping[ours])!r} is in {unit!r}, "
-                             f"not a force unit; allowed: {', '.join(UNITS)}")
+            raise ValueError(f"scene file {str(path)!r}: column {cells[ours]!r} is in {unit!r}, not a force unit; "
+                             f"allowed: {', '.join(UNITS)}")
         if unit is not None:
             named[by_lower[unit.lower()]] = ours
     if len(named) > 1:
@@ -244,27 +244,22 @@ def _resolve_units(path, header, mapping, found, units, time_scale) -> tuple:
     header_unit = next(iter(named), None)
     if units is not None and header_unit not in (None, units):
         raise ValueError(f"scene file {str(path)!r}: units={units!r} (--units {units}) but column "
-                         f"{_column(header, mapping[named[header_unit]])!r} is in {header_unit}; leave units out to "
-                         "read the header's")
-    return units or header_unit or "N", _time_scale(path, header, mapping, found.get("time"), time_scale)
+                         f"{cells[named[header_unit]]!r} is in {header_unit}; leave units out to read the header's")
+    return units or header_unit or "N", _time_scale(path, cells.get("time"), time_scale)
 
 
-def _time_scale(path, header, mapping, unit, time_scale) -> float:
+def _time_scale(path, cell, time_scale) -> float:
+    unit = None if cell is None else split_unit(cell)[1]
     if unit is None:
         return 1.0 if time_scale is None else time_scale
     if unit.lower() not in TIME_UNITS:
-        raise ValueError(f"scene file {str(path)!r}: column {_column(header, mapping['time'])!r} is in {unit!r}, "
-                         f"not a time unit; allowed: {', '.join(TIME_UNITS)}")
+        raise ValueError(f"scene file {str(path)!r}: column {cell!r} is in {unit!r}, not a time unit; allowed: "
+                         f"{', '.join(TIME_UNITS)}")
     scale = TIME_UNITS[unit.lower()]
     if time_scale is not None and not math.isclose(time_scale, scale):
         raise ValueError(f"scene file {str(path)!r}: time_scale={time_scale:g} (--time-scale {time_scale:g}) but "
-                         f"column {_column(header, mapping['time'])!r} is in {unit}; leave it out to read the header's")
+                         f"column {cell!r} is in {unit}; leave it out to read the header's")
     return scale
-
-
-def _column(header, name: str) -> str:
-    """The header cell that ``name`` matched (with its unit)."""
-    return next((h for h in header if name.lower() in (h.lower(), split_unit(h)[0].lower())), name)
 
 
 def warn_band(what: str, fs_in: float, stacklevel: int = 4) -> None:
