@@ -144,3 +144,9 @@ def test_a_pressed_hold_keeps_still_while_the_scale_drifts(fs):
     assert 0.5 < scale.min() < scale.max() < 1.0  # drifting, below the declared noise's
     out = condition_forces(f, fs, 1000.0)[0][2000:, 2]
     assert np.abs(np.diff(out)).max() * 1000.0 < 0.01  # N/s
+
+
+@pytest.mark.parametrize("value", ["yes", 1, None])
+def test_adapt_noise_must_be_a_bool(value):
+    with pytest.raises(TypeError, match=f"adapt_noise must be True or False, got {value!r}"):
+        Conditioning(adapt_noise=value)
