@@ -72,7 +72,10 @@ def main(argv=None) -> int:
     debug = args.debug or os.environ.get("DDMM_DEBUG", "") not in ("", "0")
     try:
         with warnings.catch_warnings():
-            warnings.simplefilter("default")
+            # The package's own warnings, once per place; another library's (pyparsing's deprecations inside
+            # Brian2, say) are not the user's to act on: only --debug shows them.
+            warnings.simplefilter("default" if debug else "ignore")
+            warnings.filterwarnings("default", module=r"(ddmm|__main__)(\.|$)")
             warnings.showwarning = functools.partial(_show_warning, getattr(args, "types", None))
             return int(args.func(args) or 0)
     except KeyboardInterrupt:

@@ -4,18 +4,26 @@ Input: CSV lines ``t,fx,fy,fz`` on standard input (one ``fx,fy,fz`` triple
 per site with ``--sites``; seconds, and newtons unless ``--units``; a header
 line is skipped), or an LSL force stream (``--lsl-in NAME``: 3 channels per
 site, its rate and units from the stream, docs/live-sensors.md).  Output:
-CSV lines ``t,afferent,type`` on standard output (the spike time on the
-input's clock, the afferent's id, its type), flushed after every input
-chunk, or an LSL spike stream (``--lsl-out NAME``: one int32 sample per
-spike holding the afferent id, stamped with the spike's time).  The samples
-pass through the causal conditioning stage (``--conditioning causal``, the
-default: docs/recordings.md), which brings the input's rate to the model's
-``--model-fs``; the spikes equal ``ddmm simulate`` of the same samples as a
-file.  A malformed line, a NaN or time going backwards is reported on stderr
-and skipped; a gap in the stamps (an interval over 1.5 / fs) is reported with
-its time and length, and the samples are taken as consecutive (the stream's
-clock counts samples).  It stops at the end of input, on SIGINT/SIGTERM, or
-after ``--duration`` seconds of input, and prints a one-line summary on stderr.
+CSV lines ``t,afferent,type`` on standard output (the afferent's id, its
+type), flushed after every input chunk, or an LSL spike stream
+(``--lsl-out NAME``: one int32 sample per spike holding the afferent id).
+
+**Time base.**  On standard output ``t`` is on the input's clock, in both
+modes: the first sample's time (the first CSV column, or the LSL stamp the
+sender gave it) plus the spike's model time, moved on by each gap.  A spike
+at ``t`` was caused by the samples up to ``t``.  An LSL spike stream is
+stamped on this host's LSL clock instead (the input's clock plus LSL's
+measured offset, ``clock_offset_s`` in its metadata), as LSL consumers need.
+
+The samples pass through the causal conditioning stage (``--conditioning
+causal``, the default: docs/recordings.md), which brings the input's rate to
+the model's ``--model-fs``; the spikes equal ``ddmm simulate`` of the same
+samples as a file.  A malformed line, a NaN or time going backwards is
+reported on stderr and skipped; a gap in the stamps (an interval over
+1.5 / fs) is reported with its time and length, the samples are taken as
+consecutive and the spike times move on by the gap.  It stops at the end of
+input, on SIGINT/SIGTERM, or after ``--duration`` seconds of input, and
+prints a one-line summary on stderr.
 
 ``ddmm play`` (`ddmm.experiments.cli.play`) publishes a scene's forces as an
 LSL force stream in real time: a synthetic sensor for trying ``--lsl-in``.
@@ -79,12 +87,17 @@ def _parse(line: str, n_values: int):
     return values[0], values[1:]
 
 
-def csv_sink(encoder, out):
-    """A sink writing ``t,afferent,type`` lines (afferent id, type) to ``out``, flushed per call."""
+def csv_sink(encoder, out, force=None):
+    """A sink writing ``t,afferent,type`` lines (afferent id, type) to ``out``, flushed per call.
+
+    ``t`` is on the input's clock: for an LSL ``force`` stream the bridge's
+    stamps (this host's clock) less the stream's ``clock_offset_s``.
+    """
     ids, types = encoder.population.afferent_id, encoder.population.afferent_type
+    shift_s = 0.0 if force is None else -force.clock_offset_s
 
     def sink(positions, stamps):
-        out.write("".join(f"{t:.6f},{ids[a]},{types[a]}\n" for a, t in zip(positions, stamps)))
+        out.write("".join(f"{t + shift_s:.6f},{ids[a]},{types[a]}\n" for a, t in zip(positions, stamps)))
         out.flush()
     return sink
 
@@ -94,11 +107,13 @@ def stream(encoder, lines, out, err, scale=(1.0, 1.0, 1.0), sink=None, duration=
 
     ``scale`` multiplies each sample's (fx, fy, fz): units and sign.  Returns the lines skipped.
     """
+    from ddmm.population.runtime.lsl_bridge import GAP_FACTOR
+
     sink = sink or csv_sink(encoder, out)
     n_sites = 1 if encoder.sites is None else len(encoder.sites)
     shape = (1, 3) if encoder.sites is None else (1, n_sites, 3)
     limit = None if duration is None else int(round(duration * encoder.fs))
-    t0, last, bad, taken = None, None, 0, 0
+    anchor, last, bad, taken = None, None, 0, 0  # anchor: the input's time of the model's t = 0
     for number, line in enumerate(lines, start=1):
         if not line.strip() or (number == 1 and line[:1].isalpha()):
             continue
@@ -109,12 +124,13 @@ def stream(encoder, lines, out, err, scale=(1.0, 1.0, 1.0), sink=None, duration=
             bad += 1
             print(f"ddmm: line {number} skipped: {exc}", file=err, flush=True)
             continue
-        if last is not None and t - last > 1.5 / encoder.fs:
+        if last is not None and t - last > GAP_FACTOR / encoder.fs:
             print(f"ddmm: line {number}: a gap of {t - last:.6g} s at t = {last:.6g} s; the samples are taken as "
-                  "consecutive (the stream's clock counts samples)", file=err, flush=True)
-        t0, last, taken = (t if t0 is None else t0), t, taken + 1
+                  "consecutive and the spike times move on by the gap", file=err, flush=True)
+            anchor += t - last - 1.0 / encoder.fs  # as the LSL bridge: spikes stay beside their samples
+        anchor, last, taken = (t if anchor is None else anchor), t, taken + 1
         if spikes.afferent.size:
-            sink(spikes.afferent, t0 + spikes.time)
+            sink(spikes.afferent, anchor + spikes.time)
         if limit is not None and taken >= limit:
             break
     return bad
@@ -195,8 +211,8 @@ def run(args) -> int:
 
 
 def _spike_sink(args, encoder, force):
-    if args.lsl_out is None:
-        return csv_sink(encoder, sys.stdout), None
+    if args.lsl_out is None:  # stdout: the input's clock in both modes (the bridge's stamps are this host's)
+        return csv_sink(encoder, sys.stdout, force), None
     from ddmm.population.runtime.lsl_outlets import SpikeOutlet
 
     outlet = SpikeOutlet(args.lsl_out, encoder, force=force)

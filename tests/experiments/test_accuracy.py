@@ -67,6 +67,7 @@ def test_tolerance_bad_input(small):
         choose_setting(-1.0, 1000.0)
 
 
+@pytest.mark.slow  # minutes: run by `pytest -m slow`
 def test_cli_accuracy_json(capsys, tmp_path):
     code = main(["accuracy", "--engines", "direct", "--dts", "0.5,0.1", "--methods", "euler", "--json",
                  "--out", str(tmp_path)])

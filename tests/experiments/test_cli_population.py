@@ -38,6 +38,7 @@ def test_plan_prints_skips(capsys):
     assert code == 0 and "skipped (no shear" in text and "282 SAI" in text
 
 
+@pytest.mark.slow  # minutes: run by `pytest -m slow`
 def test_demo_writes_data_and_figures(capsys, tmp_path):
     code, text, _ = run(capsys, "demo", "--engine", "direct", "--quiet", "--out", tmp_path)
     assert code == 0 and "press_push_lift_90" in text

@@ -131,3 +131,40 @@ def test_a_misspelt_population_or_scene_gets_a_did_you_mean(tmp_path, capsys, ex
     assert main(["simulate", "--quiet", "--out", str(tmp_path / "o.nc"), *extra]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and re.search(match, err), err
+
+
+def test_other_libraries_warnings_stay_quiet_unless_debugging(monkeypatch, capsys):
+    """Only the package's own warnings reach the user; a library's (Brian2's pyparsing deprecations) need --debug."""
+    import argparse
+    import warnings
+
+    def command(args):
+        warnings.warn_explicit("'setResultsName' deprecated", DeprecationWarning, "pyparsing/core.py", 1,
+                               module="pyparsing.core")
+        warnings.warn_explicit("a library's note", UserWarning, "h5py/x.py", 2, module="h5py.x")
+        warnings.warn_explicit("the package's own note", UserWarning, "population/x.py", 3, module="ddmm.population.x")
+        return 0
+
+    class Parser:
+        def parse_args(self, argv):
+            return argparse.Namespace(func=command, debug="--debug" in argv, types=None)
+
+    monkeypatch.setattr("ddmm.experiments.cli.app.build_parser", Parser)
+    assert main(["x"]) == 0
+    err = capsys.readouterr().err
+    assert err == "ddmm: warning: the package's own note\n", err
+    assert main(["--debug", "x"]) == 0
+    err = capsys.readouterr().err
+    assert "ddmm: warning: 'setResultsName' deprecated" in err and "a library's note" in err
+
+
+def test_a_brian2_run_prints_no_warning(tmp_path):
+    """The default engine, in a fresh process as a user runs it: nothing on stderr."""
+    import os
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-m", "ddmm.experiments.cli", "simulate", "--population", "fingertip",
+                           "--engine", "brian2", "--quiet", "--out", str(tmp_path / "o.nc")],
+                          capture_output=True, text=True, timeout=600, env={**os.environ, "DDMM_PROGRESS": "0"})
+    assert done.returncode == 0 and done.stderr == "", done.stderr

@@ -24,6 +24,7 @@ def _current():
     return np.tile(np.linspace(0.0, 30.0, 7), (300, 1))
 
 
+@pytest.mark.slow  # builds Brian2 projects in fresh processes: run by `pytest -m slow`
 def test_two_processes_building_into_one_empty_cache_both_succeed(tmp_path):
     cache = tmp_path / "cache"
     env = dict(os.environ, DDMM_CACHE_DIR=str(cache))
@@ -38,6 +39,7 @@ def test_two_processes_building_into_one_empty_cache_both_succeed(tmp_path):
     assert len(builds) == 1 and (builds[0] / "main.sha256").is_file()
 
 
+@pytest.mark.slow  # builds Brian2 projects in fresh processes: run by `pytest -m slow`
 @pytest.mark.parametrize("damage", ["truncate", "empty"])
 def test_a_damaged_binary_is_rebuilt_with_a_notice(capsys, monkeypatch, damage, tmp_path):
     # A cache of its own: damaging the shared one raced another test worker running that binary
@@ -73,6 +75,7 @@ def test_an_unsafe_cache_directory_is_refused(tmp_path):
     assert oct(os.stat(private_dir(tmp_path / "new" / "deep")).st_mode & 0o777) == "0o700"
 
 
+@pytest.mark.slow  # builds Brian2 projects in fresh processes: run by `pytest -m slow`
 def test_a_build_killed_midway_leaves_nothing_where_the_cache_looks(tmp_path, monkeypatch):
     """Builds go to a temporary directory installed by rename: a failure midway leaves no project at the key,
     the next build sweeps what a killed one left, and installs a verified binary."""
@@ -99,6 +102,7 @@ def test_a_build_killed_midway_leaves_nothing_where_the_cache_looks(tmp_path, mo
     np.testing.assert_array_equal(first.step, direct.step)
 
 
+@pytest.mark.slow  # builds Brian2 projects in fresh processes: run by `pytest -m slow`
 def test_an_installed_binary_is_never_rewritten_in_place(monkeypatch, tmp_path):
     """A process whose generated project differs relinks a copy and installs it whole, with its digest: another
     process may be running the installed binary, and a binary changed in place no longer matches its digest."""
@@ -122,6 +126,7 @@ def test_an_installed_binary_is_never_rewritten_in_place(monkeypatch, tmp_path):
     assert engine._verified(build) and (build / "main").stat().st_ino != before
 
 
+@pytest.mark.slow  # builds Brian2 projects in fresh processes: run by `pytest -m slow`
 def test_fresh_processes_generate_the_same_project(tmp_path):
     """Brian2 sets the clocks' start values in a set's order; the engine's device sorts them, so a cached
     build stays as it is from process to process (it was relinked in every other process)."""

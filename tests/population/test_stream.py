@@ -176,3 +176,34 @@ def test_warm_up_changes_no_spike_and_refuses_once_samples_were_pushed(setup):
     np.testing.assert_array_equal(out.time, offline["direct"].spike_time.values)
     with pytest.raises(ValueError, match="warm_up\\(\\) goes before the first push; 3000 samples"):
         enc.warm_up()
+
+
+def test_stdout_times_are_on_the_input_clock_in_both_modes(capsys, monkeypatch):
+    """The same stamped samples, with a gap, give the same stdout lines from stdin and through the LSL bridge.
+
+    Both are on the input's clock (the bridge's own stamps carry the host's clock offset), and both move the
+    spike times on by the gap, so a spike stays beside the samples that caused it.
+    """
+    import io
+
+    from ddmm.experiments.cli import main
+    from ddmm.experiments.cli.stream import csv_sink
+    from ddmm.population.runtime.lsl import ForceStream
+    from ddmm.population.runtime.lsl_bridge import Bridge
+
+    t = 5.0 + np.r_[np.arange(0, 0.4, 0.001), np.arange(0.45, 0.8, 0.001)]  # a 50 ms gap at 5.4 s
+    f = np.column_stack([0 * t, 0.3 * np.interp(t, [5.0, 5.1, 6], [0, 3, 3]), np.interp(t, [5.0, 5.1, 6], [0, 3, 3])])
+    lines = ["t,fx,fy,fz"] + [",".join(map(repr, map(float, row))) for row in np.column_stack([t, f])]
+    monkeypatch.setattr("sys.stdin", io.StringIO("\n".join(lines) + "\n"))
+    assert main(["stream", "--fs", "1000", "--seed", "2", "--conditioning", "off", "--types", "SAI,RAI"]) == 0
+    from_stdin, err = capsys.readouterr()
+    assert "a gap of 0.051 s at t = 5.399 s" in err
+
+    pop = sample_population("fingertip", rng=2)
+    enc = Encoder(pop, 1000.0, seed=2, afferent_types=("SAI", "RAI"), conditioning=None)
+    force = ForceStream("fake", "fake-id", "host", 1000.0, 1, "N", 1, 123.25, inlet=None)
+    out = io.StringIO()
+    Bridge(enc, force, csv_sink(enc, out, force)).consume(f, t)
+    assert out.getvalue() == from_stdin
+    times = np.array([float(r.split(",")[0]) for r in from_stdin.splitlines()])
+    assert times.min() > 5.0 and (times > 5.45).any() and not ((times > 5.4) & (times < 5.45)).any()
