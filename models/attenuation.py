@@ -36,7 +36,7 @@ import numba as nb
 import numpy as np
 
 from ddmm.models.nap import get_profile, radius_scalar, tip_radius, validate_k
-from ddmm.utils.validation import as_finite_array, check_choice, check_positive
+from ddmm.utils.validation import as_finite_array, as_float_array, check_choice, check_positive, shown
 
 __all__ = [
     "F_TH",
@@ -70,7 +70,7 @@ def shear_magnitude(fx, fy) -> np.ndarray:
     >>> float(shear_magnitude(3.0, 4.0))
     5.0
     """
-    return np.hypot(np.asarray(fx, dtype=float), np.asarray(fy, dtype=float))
+    return np.hypot(as_finite_array(fx, "fx"), as_finite_array(fy, "fy"))
 
 
 def _unique_directions(fx, fy, active):
@@ -310,10 +310,12 @@ def attenuated_force(fz, af, depth: float = 1.0) -> np.ndarray:
     >>> attenuated_force([2.0], [[0.5, 1.0]], depth=0.5).tolist()
     [[1.5, 2.0]]
     """
-    fz = np.asarray(fz, dtype=float)
+    fz = as_finite_array(fz, "fz", ndim=1)
     if isinstance(depth, bool) or not isinstance(depth, (int, float)) or not 0.0 <= depth <= 1.0:
-        raise ValueError(f"depth must be a number in [0, 1] (1: eq. 18), got {depth!r}")
-    af = np.asarray(af, dtype=float)
+        raise ValueError(f"depth must be a number in [0, 1] (1: eq. 18), got {shown(depth)}")
+    af = as_float_array(af, "af", ndim=2)
+    if af.shape[0] != fz.size:
+        raise ValueError(f"af must have one row per sample of fz ({fz.size}), got shape {af.shape}")
     if depth != 1.0:  # the `_fused_drive._sheared` arithmetic, in its order
         af = 1.0 + depth * (af - 1.0)
     return af * fz[:, None]

@@ -23,7 +23,7 @@ from ddmm.models.afferent_types import AFFERENT_TYPES
 from ddmm.models.current_params import CurrentParams, TypeCurrentParams
 from ddmm.utils.cache import cache_root
 from ddmm.utils.deprecation import renamed_keyword, warn_renamed
-from ddmm.utils.validation import as_finite_array, check_positive
+from ddmm.utils.validation import as_finite_array, check_instance, check_positive
 
 __all__ = ["RAII_FS_FACTOR", "FilterState", "check_fs", "filter_force", "initial_filter_state", "lowpass_sos",
            "type_filter_constants"]
@@ -207,6 +207,8 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
         State after the last sample.
     """
     f_a = as_finite_array(f_a, "f_a", ndim=2)
+    fs = check_positive(fs, "fs", "Hz")
+    check_instance(params, "params", CurrentParams, "a CurrentParams")
     shared = TypeCurrentParams("RAI", 0, params.cutoff_hz, params.filter_order, 0.0, 1.0, 1.0, None, None, 0.0)
     if state is None:
         state = initial_filter_state(f_a[0], fs, params)

@@ -100,7 +100,7 @@ from ddmm.models.variability import (
     initial_phase,
     tonic_current,
 )
-from ddmm.utils.validation import as_finite_array, check_positive
+from ddmm.utils.validation import as_finite_array, check_instance, check_positive
 
 __all__ = [
     "PAPER_TYPES",
@@ -180,6 +180,7 @@ def afferent_current(
     afferent_type = normalize_type(afferent_type)
     fs = check_positive(fs, "fs", "Hz")
     f_a = as_finite_array(f_a, "f_a", ndim=2)
+    check_instance(params, "params", CurrentParams, "a CurrentParams")
     check_fs(fs, params, (afferent_type,))
     if sensitivity is not None:
         sensitivity = as_finite_array(sensitivity, "sensitivity", ndim=1)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.utils.validation import as_finite_array, check_positive
+from ddmm.utils.validation import as_finite_array, as_float_array, check_count, check_positive, shown
 
 __all__ = ["CONTACT_THRESHOLD", "SF_DEFINITIONS", "active_mask", "spiking_frequency", "direction_index"]
 
@@ -74,8 +74,12 @@ def spiking_frequency(step, n_afferents: int, *, fz, fs: float, substeps: int, a
         raise ValueError(f"definition={definition!r} is not allowed; allowed: {', '.join(SF_DEFINITIONS)}")
     active = active_mask(fz, threshold)
     fs = check_positive(fs, "fs", "Hz")
-    step = np.asarray(step, dtype=np.int64)
-    afferent = np.zeros_like(step) if afferent is None else np.asarray(afferent, dtype=np.int64)
+    substeps = check_count(substeps, "substeps")
+    n_afferents = check_count(n_afferents, "n_afferents", minimum=0)
+    step = _indices(step, "step")
+    afferent = np.zeros_like(step) if afferent is None else _indices(afferent, "afferent", n_afferents)
+    if afferent.shape != step.shape:
+        raise ValueError(f"afferent must have one entry per spike ({step.size}), got {afferent.size}")
     sample = np.minimum(step // substeps, active.size - 1)
     inside = active[sample]
     if definition == "peak_bin":
@@ -87,6 +91,16 @@ def spiking_frequency(step, n_afferents: int, *, fz, fs: float, substeps: int, a
     counts = np.bincount(afferent[inside], minlength=n_afferents).astype(float)
     seconds = active.sum() / fs
     return counts / seconds if seconds > 0 else np.zeros(n_afferents)
+
+
+def _indices(values, name: str, end: int | None = None) -> np.ndarray:
+    """``values`` as a 1-D int64 array of whole numbers >= 0 (and < ``end``); errors name ``name``."""
+    arr = as_float_array(values, name, ndim=1)
+    bad = ~np.isfinite(arr) | (arr < 0) | (arr != np.floor(arr)) | (arr >= (np.inf if end is None else end))
+    if np.any(bad):
+        allowed = "whole numbers >= 0" + ("" if end is None else f" and < {end}")
+        raise ValueError(f"{name} must hold {allowed}, got {shown(arr[bad][0])} at index {int(np.flatnonzero(bad)[0])}")
+    return arr.astype(np.int64)
 
 
 def direction_index(r0, r90, r180, r270):
@@ -101,7 +115,10 @@ def direction_index(r0, r90, r180, r270):
     >>> float(direction_index(1.0, 3.0, 1.0, 1.0))
     0.333...
     """
-    r = [np.asarray(x, dtype=float) for x in (r0, r90, r180, r270)]
+    r = [as_finite_array(x, name) for x, name in zip((r0, r90, r180, r270), ("r0", "r90", "r180", "r270"))]
+    for x, name in zip(r, ("r0", "r90", "r180", "r270")):
+        if np.any(x < 0):
+            raise ValueError(f"{name} must be a response >= 0 (a rate or count), got {shown(x[x < 0].flat[0])}")
     total = r[0] + r[1] + r[2] + r[3]
     num = np.hypot(r[0] - r[2], r[1] - r[3])
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -22,6 +22,8 @@ from functools import lru_cache
 import numba as nb
 import numpy as np
 
+from ddmm.utils.validation import as_finite_array, as_float_array
+
 __all__ = [
     "NAPProfile",
     "PROFILES",
@@ -115,13 +117,13 @@ def validate_k(k, profile: str | NAPProfile) -> np.ndarray:
         If any k is not finite, is <= 0, or (broad) is below 1.8.
     """
     prof = get_profile(profile)
-    k = np.asarray(k, dtype=float)
+    k = as_float_array(k, "k")
     bad = ~np.isfinite(k) | (k <= 0.0) | (k < prof.k_min)
     if np.any(bad):
         first = k[bad].flat[0]
         need = f">= {prof.k_min}" if prof.k_min > 0 else "> 0"
         raise ValueError(
-            f"k={first!r} is not allowed for the {prof.name} profile; k must be finite and {need}"
+            f"k={float(first)!r} is not allowed for the {prof.name} profile; k must be finite and {need}"
         )
     return k
 
@@ -154,11 +156,11 @@ def k_from_selectivity(theta_a_deg, profile: str | NAPProfile):
     3.0
     """
     prof = get_profile(profile)
-    theta = np.asarray(theta_a_deg, dtype=float)
+    theta = as_float_array(theta_a_deg, "theta_a_deg")
     bad = ~np.isfinite(theta) | (theta <= 0.0) | (theta >= 180.0)
     if np.any(bad):
         raise ValueError(
-            f"theta_a={theta[bad].flat[0]!r} deg is outside the open interval (0, 180) deg"
+            f"theta_a_deg={float(theta[bad].flat[0])!r} deg is outside the open interval (0, 180) deg"
         )
     k = prof.b / np.tan(np.deg2rad(theta) / 2.0)
     validate_k(k, prof)
@@ -216,7 +218,7 @@ def boundary_radius(sin_phi, cos_phi, profile: str | NAPProfile, k) -> np.ndarra
     """
     prof = get_profile(profile)
     k = validate_k(k, prof)
-    r = _radius_ufunc()(np.asarray(sin_phi, dtype=float), np.asarray(cos_phi, dtype=float), k,
+    r = _radius_ufunc()(as_finite_array(sin_phi, "sin_phi"), as_finite_array(cos_phi, "cos_phi"), k,
                         prof.p1, prof.p2, prof.p3, prof.p4, prof.p5)
     if not np.all(np.isfinite(r)):  # pragma: no cover - geometry guarantees a root
         raise FloatingPointError(f"no boundary root for the {prof.name} profile")

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
-from ddmm.utils.validation import shown
+from ddmm.utils.validation import as_finite_array, shown
 
 __all__ = [
     "V_PEAK",
@@ -121,7 +121,7 @@ def resting_state(b) -> tuple[np.ndarray, np.ndarray]:
     >>> round(float(v), 6), round(float(u), 6)
     (-70.0, -14.0)
     """
-    b = np.asarray(b, dtype=float)
+    b = as_finite_array(b, "b")
     disc = (5.0 - b) ** 2 - 4.0 * 0.04 * 140.0
     if np.any(disc < 0.0):
         raise ValueError(f"b={shown(b)} leaves eq. 4-5 without a resting state (b must be <= 0.267)")

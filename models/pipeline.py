@@ -20,7 +20,7 @@ from ddmm.models.attenuation import (
 from ddmm.models.current_params import CurrentParams
 from ddmm.models.currents import afferent_current
 from ddmm.models.engines import SpikeResult, integrate
-from ddmm.utils.validation import check_forces, check_positive
+from ddmm.utils.validation import as_finite_array, check_forces, check_instance, check_positive
 
 __all__ = ["compute_currents", "simulate_afferents"]
 
@@ -79,7 +79,8 @@ def compute_currents(
     """
     fx, fy, fz = check_forces(fx, fy, fz)
     fs = check_positive(fs, "fs", "Hz")
-    theta = np.atleast_1d(np.asarray(theta_t, dtype=float))
+    check_instance(current_params, "current_params", CurrentParams, "a CurrentParams")
+    theta = np.atleast_1d(as_finite_array(theta_t, "theta_t"))
     types = np.broadcast_to(np.asarray(afferent_type, dtype=object), (theta.size,))
     unknown = sorted(set(types) - set(AFFERENT_TYPES), key=str)
     if unknown:

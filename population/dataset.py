@@ -43,7 +43,7 @@ from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.models.neuron import NEURON_PARAMS, V_PEAK
 from ddmm.population.anatomy.receptive_fields import RF_SIGMA_MM, RF_SUPPORT
 from ddmm.utils.files import read_netcdf, write_netcdf
-from ddmm.utils.validation import shown
+from ddmm.utils.validation import check_choice, check_dataset, check_positive
 
 __all__ = ["build_dataset", "save_dataset", "load_dataset", "binned_counts", "binned_rates", "psth",
            "describe_dataset", "cf_attrs", "TIME_ATTRS"]
@@ -303,6 +303,7 @@ def save_dataset(ds: xr.Dataset, path) -> Path:
     ValueError
         If the directory does not exist or cannot be written.
     """
+    check_dataset(ds)
     return write_netcdf(ds, path)
 
 
@@ -325,11 +326,11 @@ def load_dataset(path) -> xr.Dataset:
 
 def binned_counts(ds: xr.Dataset, bin_s: float, *, t_max: float | None = None) -> xr.DataArray:
     """Spike counts per (condition, trial, afferent, bin) from the events."""
+    check_dataset(ds)
     if "spike_time" not in ds:
         raise ValueError("the dataset has no spike events; simulate with record including 'spikes'")
-    if not bin_s > 0:
-        raise ValueError(f"bin_s must be > 0, got {shown(bin_s)}")
-    t_max = float(ds.duration.max()) if t_max is None else t_max
+    check_positive(bin_s, "bin_s", "s")
+    t_max = float(ds.duration.max()) if t_max is None else check_positive(t_max, "t_max", "s")
     edges = np.arange(0.0, t_max + bin_s / 2, bin_s)
     n_bins = max(1, edges.size - 1)
     b = np.minimum(_bin_index(ds.spike_time.values, bin_s), n_bins - 1)
@@ -378,12 +379,15 @@ def psth(ds: xr.Dataset, bin_s: float = 0.01, *, by: str = "afferent_type") -> x
     Averages over trials and over the afferents of each value of ``by``
     (a coordinate on ``afferent``, e.g. ``"afferent_type"`` or ``"nap"``).
     """
+    check_dataset(ds)
+    check_choice(by, "by", [k for k in ds.coords if ds[k].dims == ("afferent",)])
     rates = binned_rates(ds, bin_s).mean("trial")
     return rates.groupby(by).mean("afferent").assign_attrs(units="1/s", bin_s=bin_s)
 
 
 def describe_dataset(ds: xr.Dataset) -> str:
     """A short text summary (``ddmm info``)."""
+    check_dataset(ds)
     lines = [f"population {ds.attrs.get('population')!r}: {ds.sizes['afferent']} afferents, "
              f"{ds.sizes['condition']} condition(s), {ds.sizes['trial']} trial(s)",
              f"engine {ds.attrs['engine']}, method {ds.attrs['method']}, dt {ds.attrs['dt'] * 1e3:g} ms, "

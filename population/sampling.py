@@ -10,6 +10,7 @@ changes any afferent's result.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,6 +30,7 @@ from ddmm.population.spec import (
     TypeSpec,
     load_spec,
 )
+from ddmm.utils.validation import as_finite_array, check_instance, check_rng
 
 __all__ = ["Population", "sample_population", "make_population"]
 
@@ -106,6 +108,8 @@ class Population:
     def __post_init__(self):
         check_shape(self.receptive_field)
         check_neuron(self.neuron)
+        check_instance(self.current, "current", CurrentParams, "a CurrentParams")
+        check_instance(self.name, "name", str, "a str")
         n = len(self.afferent_type)
         if self.region is None:
             object.__setattr__(self, "region", np.full(n, "", dtype=object))
@@ -311,10 +315,10 @@ def sample_population(spec, rng=None) -> Population:
     >>> len(pop), pop.counts()
     (991, {'SAI': 282, 'RAI': 573, 'RAII': 100, 'SAII': 36})
     """
+    check_instance(spec, "spec", (PopulationSpec, str, os.PathLike),
+                   "a PopulationSpec, a preset name ('fingertip', 'hand') or a .toml path")
     spec = load_spec(spec)
-    if not isinstance(spec, PopulationSpec):  # pragma: no cover - load_spec guarantees it
-        raise TypeError(f"spec must be a PopulationSpec, got {type(spec).__name__}")
-    rng = np.random.default_rng(rng)
+    rng = check_rng(rng)
     placements = _placements(spec)
     parts = [_sample_type(kind, tspec, *placements[kind], rng) for kind, tspec in spec.types.items()]
     arrays = {name: np.concatenate([p[name] for p in parts]) for name in parts[0]}
@@ -340,14 +344,23 @@ def make_population(afferent_type, theta_t=0.0, nap=UNTUNED, k=3.0, *, gain=1.0,
     types = np.array([normalize_type(t) for t in np.atleast_1d(np.asarray(afferent_type, dtype=object)).tolist()],
                      dtype=object)
     n = types.size
-    nap = np.broadcast_to(np.asarray(nap, dtype=object), (n,))
-    k = np.where(nap == UNTUNED, 0.0, np.broadcast_to(np.asarray(k, float), (n,)))
-    arrays = {name: np.broadcast_to(np.asarray(v, float), (n,)).copy()
+    if n == 0:
+        raise ValueError("afferent_type must name at least one afferent, got 0")
+    nap = _per_afferent(nap, "nap", n, object)
+    k = np.where(nap == UNTUNED, 0.0, _per_afferent(k, "k", n))
+    arrays = {name: _per_afferent(v, name, n)
               for name, v in (("theta_t", theta_t), ("gain", gain), ("x_mm", x_mm), ("y_mm", y_mm),
                               ("noise_sigma", noise_sigma), ("noise_cv", noise_cv), ("frame_deg", frame_deg),
                               ("sensitivity", sensitivity))}
-    region = np.array(np.broadcast_to(np.asarray(region, dtype=object), (n,)))
+    region = _per_afferent(region, "region", n, object)
     return Population(afferent_type=types, nap=np.array(nap), k=k, afferent_id=np.arange(n, dtype=np.int64),
                       region=region, current=current, name=name, receptive_field=receptive_field, **arrays)
 
 
+def _per_afferent(value, name: str, n: int, dtype=float) -> np.ndarray:
+    """``value`` (one for all, or one per afferent) as an array of ``n``; errors name ``name``."""
+    arr = as_finite_array(value, name) if dtype is float else np.asarray(value, dtype=object)
+    try:
+        return np.broadcast_to(arr, (n,)).copy()
+    except ValueError:
+        raise ValueError(f"{name} must be one value or one per afferent ({n}), got shape {arr.shape}") from None

@@ -23,15 +23,14 @@ from ddmm.models.current_filters import check_fs
 from ddmm.models.engines import METHODS, get_engine, prepare, substeps_for
 from ddmm.models.fused import FusedPipeline, mixing_matrix
 from ddmm.population.anatomy.receptive_fields import frame_theta, local_mixing
+from ddmm.population.runtime.memory import check_run_memory
 from ddmm.population.runtime.noise import noise_key, root_seed
-from ddmm.population.runtime.plan import _BYTES_PER_ELEMENT as _PLAN_BYTES_PER_ELEMENT
 from ddmm.population.runtime.plan import RECORD_CHOICES, make_plan
 from ddmm.population.sampling import Population
-from ddmm.population.stimuli.scenes import Scene
+from ddmm.population.stimuli.scenes import Scene, as_scenes
 from ddmm.utils.deprecation import renamed_keyword
 from ddmm.utils.executors import shared_executor
 from ddmm.utils.extras import require
-from ddmm.utils.resources import check_memory
 from ddmm.utils.validation import check_choice, check_positive, shown
 
 __all__ = ["SimConfig", "ChunkJob", "run_chunk", "simulate", "plan_run", "population_currents", "block_pipeline",
@@ -221,9 +220,7 @@ def _check_sites(scenes) -> None:
 def _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_size, time_chunk):
     if not isinstance(population, Population):
         raise TypeError(f"population must be a Population (see sample_population), got {type(population).__name__}")
-    scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
-    if not scenes or not all(isinstance(s, Scene) for s in scenes):
-        raise TypeError("scenes must be a Scene or a non-empty sequence of Scenes")
+    scenes = as_scenes(scenes)
     if len({s.fs for s in scenes}) != 1:
         raise ValueError(f"all scenes must share one sample rate, got {sorted({s.fs for s in scenes})} Hz")
     names = [s.name for s in scenes]
@@ -248,7 +245,7 @@ def _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_si
 def plan_run(population, scenes, *, trials=1, record=RECORD_CHOICES, no_shear="smooth", afferent_types=None,
              chunk_size=None, time_chunk=2000, plan=True, engine="brian2", scheduler=None):
     """The `Plan` that `simulate` would follow (print it with ``plan.describe``)."""
-    scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
+    scenes = as_scenes(scenes)
     chunk_size = default_chunk_size(engine, scheduler) if chunk_size is None else chunk_size
     return make_plan(population, scenes, afferent_types=afferent_types, trials=trials, record=record, no_shear=no_shear,
                      chunk_size=chunk_size, time_chunk=time_chunk, enabled=plan)
@@ -377,6 +374,13 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
     xarray.Dataset
         See `ddmm.population.dataset.build_dataset` for the schema.
 
+    Raises
+    ------
+    ValueError
+        Before any work, when the run's estimated peak memory, spike events
+        included (`ddmm.population.runtime.memory`), exceeds what this
+        process may use (`ddmm.utils.resources.available_bytes`).
+
     Examples
     --------
     >>> from ddmm.population import sample_population, birznieks
@@ -389,7 +393,7 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
 
     from ddmm.population.dataset import build_dataset
 
-    scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
+    scenes = as_scenes(scenes)
     dt, method, choice = _resolve_step(dt, method, tolerance, scenes)
     scenes = _validate(population, scenes, engine, dt, method, trials, no_shear, chunk_size, time_chunk)
     config = SimConfig(engine, float(dt), method, no_shear, root_seed(seed), int(time_chunk))
@@ -397,11 +401,11 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
                         afferent_types=afferent_types, chunk_size=chunk_size, time_chunk=time_chunk, plan=plan, engine=engine,
                         scheduler=scheduler)
     check_fs(scenes[0].fs, population.current, tuple(sorted(set(population.afferent_type[the_plan.selected].tolist()))))
-    _check_run_memory(population, scenes, the_plan, trials)
+    _compile_notice(quiet)  # before the memory check, whose pilot may be what compiles them
+    check_run_memory(population, scenes, the_plan, config, scheduler)
     spikes = [[] for _ in scenes]
     members = [_unit_members(cond) for cond in the_plan.conditions]
     work = list(_jobs(population, scenes, the_plan))
-    _compile_notice(quiet)
     with tqdm(total=the_plan.work(), unit="aff-sample", unit_scale=True, delay=1.0, file=sys.stderr,
               disable=_progress_disabled(quiet), leave=False) as bar:
         results = _run_jobs([job for _, job, _, _ in work], config, scheduler, bar.update)
@@ -414,14 +418,6 @@ def simulate(population, scenes, *, engine="brian2", dt=None, method=None, toler
 
 #: The smallest integration step accepted, s.
 MIN_DT = 1e-6
-
-
-def _check_run_memory(population, scenes, the_plan, trials) -> None:
-    """Refuse, before any work, a run whose counts and working set cannot fit (`ddmm.utils.resources`)."""
-    counts = 4.0 * len(scenes) * trials * len(population)  # spike_count, int32
-    working = the_plan.chunk_size * the_plan.time_chunk * _PLAN_BYTES_PER_ELEMENT * max(1, os.cpu_count() or 1)
-    check_memory(counts + working, f"a run of {len(scenes)} condition(s) x {trials:,} trial(s) x {len(population):,} "
-                 "afferents", "use fewer trials, afferents or conditions, or split the run")
 
 
 def _progress_disabled(quiet: bool):

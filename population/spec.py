@@ -44,6 +44,7 @@ import copy
 import dataclasses
 import functools
 import math
+import os
 import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
@@ -57,7 +58,7 @@ from ddmm.models.neuron import NEURON_PARAMS, NeuronParams, check_neuron
 from ddmm.population.anatomy import hand_map
 from ddmm.population.anatomy.receptive_fields import check_shape
 from ddmm.utils.deprecation import renamed_keyword
-from ddmm.utils.validation import shown
+from ddmm.utils.validation import check_instance, shown
 
 __all__ = [
     "NAP_CHOICES",
@@ -393,6 +394,9 @@ class PopulationSpec:
     neuron: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        check_instance(self.name, "name", str, "a str")
+        check_instance(self.types, "types", dict, "a dict of afferent type -> TypeSpec")
+        check_instance(self.current, "current", CurrentParams, "a CurrentParams")
         check_shape(self.receptive_field)  # one message for a spec, a population and a weight call
         check_neuron(self.neuron)
         for kind in self.types:
@@ -469,6 +473,8 @@ def spec_from_dict(data: dict, *, default_name: str = "custom") -> PopulationSpe
     >>> spec.n_afferents()
     {'SAI': 10}
     """
+    check_instance(data, "data", dict, "a dict (the TOML structure)")
+    check_instance(default_name, "default_name", str, "a str")
     data = dict(data)
     data.setdefault("name", default_name)
     allowed = {f.name for f in dataclasses.fields(PopulationSpec)}
@@ -540,6 +546,7 @@ def load_spec(source) -> PopulationSpec:
         return source
     if isinstance(source, str) and source in PRESETS:
         return copy.deepcopy(_preset(source))  # 0.1 ms; its dicts are the caller's, the cached spec stays as read
+    check_instance(source, "source", (str, os.PathLike), f"a preset name ({', '.join(PRESETS)}) or a .toml path")
     path = Path(source)
     if path.suffix != ".toml":
         raise ValueError(f"population={str(source)!r}: give a preset ({', '.join(PRESETS)}) or a .toml file")

@@ -20,7 +20,7 @@ from ddmm.utils.lazy import lazy_exports
 
 _WHERE = {
     "validation": ("as_finite_array", "check_choice", "check_forces", "check_positive", "parse_number", "shown"),
-    "resources": ("MEMORY_ENV", "available_bytes", "check_memory"),
+    "resources": ("MEMORY_ENV", "available_bytes", "check_memory", "format_bytes", "resident_bytes"),
     "executors": ("shared_executor",),
     "files": ("atomic_write", "read_netcdf", "sweep_stale_parts", "writable_parent", "write_netcdf"),
     "cache": ("cache_root", "private_dir"),

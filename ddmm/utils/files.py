@@ -8,6 +8,8 @@ import socket
 import tempfile
 from pathlib import Path
 
+from ddmm.utils.validation import check_path
+
 __all__ = ["atomic_write", "writable_parent", "sweep_stale_parts", "write_netcdf", "read_netcdf"]
 
 
@@ -80,7 +82,7 @@ def atomic_write(path, write, *, suffix: str = ".part") -> Path:
     (``mkstemp`` would leave it owner-only).  ``suffix`` ends the temporary
     name (a writer may insist on an extension).
     """
-    path = Path(path)
+    path = check_path(path)
     directory = path.parent if str(path.parent) else Path(".")
     sweep_stale_parts(directory)
     fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.name}{_tag()}", suffix=suffix)
@@ -103,7 +105,7 @@ def atomic_write(path, write, *, suffix: str = ".part") -> Path:
 
 def write_netcdf(ds, path) -> Path:
     """Write an xarray Dataset to netCDF-4 (HDF5) atomically; a directory that cannot be written is a ValueError."""
-    path = Path(path)
+    path = check_path(path)
     directory, writable = writable_parent(path)
     if not writable:
         raise ValueError(f"cannot write {str(path)!r}: {str(directory)!r} is not a writable directory")
@@ -114,7 +116,7 @@ def read_netcdf(path, what: str):
     """Read a netCDF-4 file fully into memory; a missing or unreadable file is a ValueError naming ``what``."""
     import xarray as xr
 
-    path = Path(path)
+    path = check_path(path)
     if not path.is_file():
         raise ValueError(f"{what} {str(path)!r} does not exist")
     try:

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import numbers
+import os
 import re
+from pathlib import Path
 
 import numpy as np
 
-__all__ = ["as_finite_array", "check_positive", "check_choice", "check_forces", "parse_number", "shown"]
+__all__ = ["as_float_array", "as_finite_array", "check_positive", "check_real", "check_nonnegative", "check_count",
+           "check_choice", "check_instance", "check_dataset", "check_path", "check_rng", "check_forces", "parse_number",
+           "shown"]
 
 
 def shown(value) -> str:
@@ -27,6 +31,38 @@ def shown(value) -> str:
     return repr(value)
 
 
+def as_float_array(value, name: str, ndim: int | None = None) -> np.ndarray:
+    """Return ``value`` as a float64 array (no copy of one), naming ``name`` when it is not numeric.
+
+    Unlike `as_finite_array` it does not scan for NaN: for large arrays a
+    caller has already checked.
+
+    Raises
+    ------
+    TypeError
+        If ``value`` is None, text or otherwise not numeric.
+    ValueError
+        If it has the wrong number of dimensions.
+
+    Examples
+    --------
+    >>> as_float_array([1, 2], "fz").tolist()
+    [1.0, 2.0]
+    >>> as_float_array("x", "fz")
+    Traceback (most recent call last):
+    TypeError: fz must be numeric, got str
+    """
+    try:
+        arr = np.asarray(value, dtype=float) if value is not None else None
+    except (TypeError, ValueError):
+        arr = None
+    if arr is None:
+        raise TypeError(f"{name} must be numeric, got {type(value).__name__}")
+    if ndim is not None and arr.ndim != ndim:
+        raise ValueError(f"{name} must be {ndim}-D, got shape {arr.shape}")
+    return arr
+
+
 def as_finite_array(value, name: str, ndim: int | None = None) -> np.ndarray:
     """Return ``value`` as a float64 array, raising if it holds NaN or inf.
 
@@ -37,12 +73,7 @@ def as_finite_array(value, name: str, ndim: int | None = None) -> np.ndarray:
     ValueError
         If it has the wrong number of dimensions or a non-finite entry.
     """
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be numeric, got {type(value).__name__}") from None
-    if ndim is not None and arr.ndim != ndim:
-        raise ValueError(f"{name} must be {ndim}-D, got shape {arr.shape}")
+    arr = as_float_array(value, name, ndim)
     if not np.all(np.isfinite(arr)):
         bad = int(np.flatnonzero(~np.isfinite(arr.ravel()))[0])
         raise ValueError(
@@ -60,6 +91,96 @@ def check_positive(value, name: str, unit: str = "") -> float:
         suffix = f" {unit}" if unit else ""
         raise ValueError(f"{name} must be a finite number > 0{suffix}, got {shown(value)}")
     return value
+
+
+def check_real(value, name: str, unit: str = "") -> float:
+    """Return ``value`` as a float after checking it is a finite real number (of any sign).
+
+    Examples
+    --------
+    >>> check_real(np.float64(-2.5), "start_deg")
+    -2.5
+    >>> check_real("up", "start_deg")
+    Traceback (most recent call last):
+    TypeError: start_deg must be a real number, got str
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
+    if not np.isfinite(value):
+        raise ValueError(f"{name} must be a finite number{f' of {unit}' if unit else ''}, got {shown(value)}")
+    return float(value)
+
+
+def check_nonnegative(value, name: str, unit: str = "") -> float:
+    """Return ``value`` as a float after checking it is finite and >= 0."""
+    value = check_real(value, name, unit)
+    if value < 0.0:
+        raise ValueError(f"{name} must be a finite number >= 0{f' {unit}' if unit else ''}, got {shown(value)}")
+    return value
+
+
+def check_count(value, name: str, minimum: int = 1) -> int:
+    """Return ``value`` as an int after checking it is an integer >= ``minimum``.
+
+    Examples
+    --------
+    >>> check_count(np.int64(3), "trials")
+    3
+    >>> check_count(0, "trials")
+    Traceback (most recent call last):
+    ValueError: trials must be an integer >= 1, got 0
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer, got {type(value).__name__} {shown(value)}")
+    if value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {shown(value)}")
+    return int(value)
+
+
+def check_instance(value, name: str, kind, what: str):
+    """Return ``value`` if it is an instance of ``kind``; TypeError saying ``what`` is allowed otherwise."""
+    if not isinstance(value, kind):
+        raise TypeError(f"{name} must be {what}, got {type(value).__name__}")
+    return value
+
+
+def check_dataset(value, name: str = "ds"):
+    """Return ``value`` if it is an `xarray.Dataset` (a run of `ddmm.population.simulate`); TypeError otherwise."""
+    import xarray as xr
+
+    return check_instance(value, name, xr.Dataset, "an xarray.Dataset (e.g. from simulate or load_dataset)")
+
+
+def check_path(value, name: str = "path") -> Path:
+    """Return ``value`` as a `Path` after checking it is a non-empty str or os.PathLike.
+
+    An int would otherwise reach ``open`` as a file descriptor (reading, then
+    closing, whatever the process has open there).
+
+    Examples
+    --------
+    >>> check_path("run.nc").name
+    'run.nc'
+    >>> check_path(5)
+    Traceback (most recent call last):
+    TypeError: path must be a file path (str or os.PathLike), got int
+    """
+    if not isinstance(value, (str, os.PathLike)):
+        raise TypeError(f"{name} must be a file path (str or os.PathLike), got {type(value).__name__}")
+    if not os.fspath(value):
+        raise ValueError(f"{name} must be a file path, got an empty string")
+    return Path(value)
+
+
+def check_rng(value, name: str = "rng") -> np.random.Generator:
+    """``numpy.random.default_rng(value)``, its refusal naming ``name`` (a Generator, an int seed >= 0 or None)."""
+    allowed = "a numpy.random.Generator, an integer seed >= 0 or None"
+    try:
+        return np.random.default_rng(value)
+    except TypeError:
+        raise TypeError(f"{name} must be {allowed}, got {type(value).__name__}") from None
+    except ValueError:
+        raise ValueError(f"{name} must be {allowed}, got {shown(value)}") from None
 
 
 def check_choice(value, name: str, allowed) -> str:

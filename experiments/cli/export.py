@@ -49,7 +49,7 @@ def _start_time(text):
 def run_export(args) -> int:
     from ddmm.population import load_dataset, to_nwb
 
-    out = check_out_file(args.nwb, ".nwb", "--nwb")
+    out = check_out_file(args.nwb, ".nwb", "--nwb", inputs={"dataset": args.file, "--pulses": args.pulses})
     ds = load_dataset(args.file)
     pulses = None
     if args.pulses is not None:

@@ -125,8 +125,8 @@ def _array_scene(args):
     refuse_csv_options(args, args.scene)
     conditioning = conditioning_from_args(args)
     if suffix in EXTENSIONS:
-        return from_array(args.scene, conditioning=conditioning)
-    return from_long_csv(args.scene, args.sites, conditioning=conditioning)
+        return from_array(args.scene, conditioning=conditioning, max_force_n=args.max_force)
+    return from_long_csv(args.scene, args.sites, conditioning=conditioning, max_force_n=args.max_force)
 
 
 def scenes_from_args(args) -> list:
@@ -180,13 +180,32 @@ def population_from_args(args):
     return sample_population(load_spec(args.population), rng=args.seed)
 
 
-def check_out_file(path, suffix: str = ".nc", option: str = "--out") -> Path:
-    """Fail before the work if ``path`` cannot be written (a probe file is created)."""
+def _same_file(a: Path, b) -> bool:
+    """Whether two paths name one file (the same resolved path, or a hard or symbolic link to it)."""
+    import os
+
+    try:
+        return a.resolve() == Path(b).resolve() or (a.exists() and os.path.samefile(a, b))
+    except (OSError, ValueError):  # b missing or not a path: not the same file
+        return False
+
+
+def check_out_file(path, suffix: str = ".nc", option: str = "--out", inputs: dict | None = None) -> Path:
+    """Fail before the work if ``path`` cannot be written (a probe file is created), or is one of ``inputs``.
+
+    ``inputs`` maps how the command names each input file (``"--scene"``,
+    ``"dataset"``) to its path (None where not given): an output written over
+    its own input would destroy it.
+    """
     import tempfile
 
     path = Path(path)
     if path.suffix != suffix:
         raise ValueError(f"{option} {str(path)!r} must end in {suffix}")
+    for name, source in (inputs or {}).items():
+        if source is not None and _same_file(path, source):
+            raise ValueError(f"{option} {str(path)!r} is the input {name} {str(source)!r}: writing it would destroy "
+                             "the input; choose another name")
     if not path.parent.is_dir():
         raise ValueError(f"{option} {str(path)!r}: directory {str(path.parent)!r} does not exist")
     try:

@@ -16,7 +16,7 @@ _CONDITIONING = {"noise_n": "sensor_noise", "bandwidth_hz": "bandwidth", "shear_
 
 def add_recording_options(p, *, stream: bool = False) -> None:
     """Add the recording options to a subcommand's parser (the file-only ones unless ``stream``)."""
-    from ddmm.population.stimuli.file_options import GAPS, NEGATIVE_FZ, UNITS
+    from ddmm.population.stimuli.file_options import GAPS, MAX_FORCE_N, NEGATIVE_FZ, UNITS
 
     g = p.add_argument_group("recorded forces" + ("" if stream else " (--scene FILE.csv)"))
     if not stream:
@@ -36,6 +36,9 @@ def add_recording_options(p, *, stream: bool = False) -> None:
                                                                 "the unit the headers name, as in 'Fz (mN)', else N)"))
     g.add_argument("--fz-sign", type=int, choices=(1, -1), default=1,
                    help="-1 for a sensor that reports pressing as negative F_Z")
+    g.add_argument("--max-force", type=float, default=MAX_FORCE_N, metavar="N",
+                   help=f"refuse a force beyond N newtons at a site (default {MAX_FORCE_N:g}: no hand contact comes "
+                        "near; beyond it the input is in the wrong unit)")
     g.add_argument("--conditioning", choices=("causal", "zero_phase", "off"), default="causal",
                    help="the conditioning stage between the recording and the model (default causal; "
                         "zero_phase offline only; docs/recordings.md)")
@@ -93,4 +96,4 @@ def csv_scene(path, args, contact):
 
     return from_csv(path, columns=_columns(args.columns), recorded_fs=args.fs, time_scale=args.time_scale,
                     units=args.units, fz_sign=args.fz_sign, negative_fz=args.negative_fz, gaps=args.gaps,
-                    conditioning=conditioning_from_args(args), contact=contact)
+                    conditioning=conditioning_from_args(args), contact=contact, max_force_n=args.max_force)

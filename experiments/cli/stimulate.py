@@ -19,6 +19,9 @@ __all__ = ["register", "run_stimulate", "RULE_OPTIONS"]
 #: The rule settings the command line takes, and the rules each applies to.
 RULE_OPTIONS = {"force_sat": ("linear-amplitude", "linear-frequency"), "rate_hz": ("linear-amplitude",),
                 "rate_sat": ("biomimetic",), "tau": ("biomimetic",)}
+#: Each option's rule setting, the factor to the rule's unit and the option's unit (ranges: rules.RANGES).
+_SETTINGS = {"force_sat": ("force_sat_n", 1.0, "N"), "rate_hz": ("rate_hz", 1.0, "Hz"),
+             "rate_sat": ("rate_sat_hz", 1.0, "Hz"), "tau": ("tau_s", 1e-3, "ms")}
 
 
 def register(sub) -> None:
@@ -31,28 +34,34 @@ def register(sub) -> None:
     p.add_argument("--rule", default="biomimetic", choices=("biomimetic", "linear-amplitude", "linear-frequency"))
     p.add_argument("--out", required=True, metavar="PULSES.nc", help="pulses file (figures are written beside it)")
     p.add_argument("--force-sat", type=float, default=None, metavar="N",
-                   help="linear rules: force under the field at which the output saturates (default 5)")
-    p.add_argument("--rate-hz", type=float, default=None, metavar="HZ", help="linear-amplitude: the pulse rate")
+                   help="linear rules: force under the field at which the output saturates, in (0.05, 500] "
+                        "(default 5)")
+    p.add_argument("--rate-hz", type=float, default=None, metavar="HZ",
+                   help="linear-amplitude: the pulse rate, in [1, 2000] (default 100)")
     p.add_argument("--rate-sat", type=float, default=None, metavar="HZ",
-                   help="biomimetic: aggregate rate (spikes/s per field afferent) giving the maximum pulse rate")
-    p.add_argument("--tau", type=float, default=None, metavar="MS", help="biomimetic: smoothing of the aggregate rate")
+                   help="biomimetic: aggregate rate (spikes/s per field afferent) giving the maximum pulse rate, "
+                        "in (0, 1000] (default 100)")
+    p.add_argument("--tau", type=float, default=None, metavar="MS",
+                   help="biomimetic: smoothing of the aggregate rate, in (0, 1000] (default 20)")
     p.add_argument("--no-figures", action="store_true", help="write the pulses file only")
     p.set_defaults(func=run_stimulate)
 
 
 def _rule(args):
     from ddmm.population.neurostim import RULES
+    from ddmm.population.neurostim.rules import check_setting
 
     settings = {}
     for option, rules in RULE_OPTIONS.items():
         value = getattr(args, option)
         if value is None:
             continue
+        flag = f"--{option.replace('_', '-')}"
         if args.rule not in rules:
-            raise ValueError(f"--{option.replace('_', '-')} applies to the {' and '.join(rules)} rule(s), not "
-                             f"--rule {args.rule}")
-        name = {"force_sat": "force_sat_n", "rate_sat": "rate_sat_hz", "tau": "tau_s"}.get(option, option)
-        settings[name] = value * 1e-3 if option == "tau" else value
+            raise ValueError(f"{flag} applies to the {' and '.join(rules)} rule(s), not --rule {args.rule}")
+        name, scale, unit = _SETTINGS[option]
+        check_setting(flag, name, value, scale, unit)  # in the option's unit: --tau 1e15 (ms) would emit nothing
+        settings[name] = value * scale
     return RULES[args.rule](**settings)
 
 
@@ -73,7 +82,7 @@ def run_stimulate(args) -> int:
     from ddmm.population import load_dataset
     from ddmm.population.neurostim import read_electrodes, save_pulses, stimulation_pulses
 
-    out = check_out_file(args.out, ".nc", "--out")
+    out = check_out_file(args.out, ".nc", "--out", inputs={"dataset": args.file, "--electrodes": args.electrodes})
     table, rule = read_electrodes(args.electrodes), _rule(args)
     pulses = stimulation_pulses(load_dataset(args.file), table, rule)
     save_pulses(pulses, out)

@@ -41,7 +41,7 @@ from ddmm.experiments.cli.options import add_engine_option, step_ms
 from ddmm.experiments.cli.recording_options import add_recording_options, conditioning_from_args
 from ddmm.experiments.io import quiet_liblsl, seed_arg
 
-__all__ = ["register", "stop_on_signals", "stream"]
+__all__ = ["bounded_lines", "register", "stop_on_signals", "stream"]
 
 
 def register(sub) -> None:
@@ -78,13 +78,33 @@ def register(sub) -> None:
 
 
 def _parse(line: str, n_values: int):
+    from ddmm.utils.validation import parse_number  # as the file readers parse: '1_0' is not 10
+
     parts = line.strip().split(",")
     if len(parts) != n_values:
         raise ValueError(f"expected {n_values} values t,fx,fy,fz{',...' if n_values > 4 else ''}, got {len(parts)}")
-    values = np.array([float(x) for x in parts])
+    values = np.array([parse_number(x) for x in parts])
     if not np.all(np.isfinite(values)):
         raise ValueError("non-finite value")
     return values[0], values[1:]
+
+
+def bounded_lines(source, max_chars: int):
+    """The lines of ``source`` (a text stream, or any iterable of lines), none read beyond ``max_chars``.
+
+    A longer line, or one holding a NUL character, raises ValueError naming
+    it: a binary or runaway input (``< /dev/zero``) is refused, not read
+    whole into memory.
+    """
+    readline = getattr(source, "readline", None)
+    lines = iter(source) if readline is None else iter(lambda: readline(max_chars + 1), "")
+    for number, line in enumerate(lines, start=1):
+        if len(line) > max_chars:
+            raise ValueError(f"standard input: line {number} is longer than {max_chars:,} characters, not a line of "
+                             "t,fx,fy,fz (a binary input?)")
+        if "\x00" in line:
+            raise ValueError(f"standard input: line {number} holds a NUL character: the input is not text")
+        yield line
 
 
 def csv_sink(encoder, out, force=None):
@@ -114,7 +134,8 @@ def stream(encoder, lines, out, err, scale=(1.0, 1.0, 1.0), sink=None, duration=
     shape = (1, 3) if encoder.sites is None else (1, n_sites, 3)
     limit = None if duration is None else int(round(duration * encoder.fs))
     anchor, last, bad, taken = None, None, 0, 0  # anchor: the input's time of the model's t = 0
-    for number, line in enumerate(lines, start=1):
+    max_chars = 64 * (1 + 3 * n_sites) + 256  # room for any decimal notation of each value
+    for number, line in enumerate(bounded_lines(lines, max_chars), start=1):
         if not line.strip() or (number == 1 and line[:1].isalpha()):
             continue
         try:
@@ -178,7 +199,8 @@ def _encoder(args, fs, sites):
     return Encoder(sample_population(load_spec(args.population), rng=args.seed), fs, dt=args.dt * 1e-3,
                    engine=args.engine, seed=args.seed, afferent_types=parse_types(args.types),
                    contact=parse_contact(args.contact),
-                   sites=sites, conditioning=conditioning, model_fs=None if conditioning is None else args.model_fs)
+                   sites=sites, conditioning=conditioning, model_fs=None if conditioning is None else args.model_fs,
+                   max_force_n=args.max_force)
 
 
 def run(args) -> int:

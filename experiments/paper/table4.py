@@ -23,6 +23,7 @@ import warnings
 from ddmm.experiments.paper.reproduce import PROFILES, scene_sf
 from ddmm.models.afferent_types import PAPER_TYPES
 from ddmm.models.engines import SpikeCapWarning
+from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.population.data.published import PAPER_TABLE4
 
 __all__ = ["TABLE4_ANGLES", "table4"]
@@ -47,10 +48,22 @@ def _cells(kind: str, sf: dict) -> list:
 
 
 def table4(path, calibration: dict, args) -> dict:
-    """Table IV's cells on the recording at ``path`` (read with the recording options in ``args``)."""
+    """Table IV's cells on the recording at ``path`` (read with the recording options in ``args``).
+
+    Raises
+    ------
+    ValueError
+        If the recording's normal force never exceeds the contact threshold
+        (0.05 N): every SF would be 0.
+    """
     from ddmm.experiments.cli.recording_options import csv_scene
 
     scene = csv_scene(path, args, None)
+    peak = float(scene.fz.max())
+    if not peak > CONTACT_THRESHOLD:  # SF is the mean rate in contact: Table IV would be all zeros
+        raise ValueError(f"recording {str(path)!r} never reaches contact: its normal force peaks at {peak:g} N (as "
+                         f"read and conditioned), never above the contact threshold {CONTACT_THRESHOLD:g} N, so Table "
+                         "IV's SF (the mean rate in contact) has nothing to average")
     cells = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SpikeCapWarning)

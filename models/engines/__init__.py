@@ -51,6 +51,14 @@ class NeuronState:
     u: np.ndarray
     r: np.ndarray | None = None
 
+    def __post_init__(self):  # sizes are checked against the currents by `integrate`
+        for name in ("v", "u", "r"):
+            value = getattr(self, name)
+            arr = np.asarray(value)
+            if (value is not None or name != "r") and (arr.dtype.kind not in "iuf" or arr.ndim != 1):
+                raise TypeError(f"NeuronState {name} must be a 1-D numeric array (one value per neuron), got "
+                                f"{type(value).__name__} of dtype {arr.dtype} and shape {arr.shape}")
+
 
 @dataclass(frozen=True)
 class SpikeResult:

@@ -18,13 +18,25 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from ddmm.utils.validation import (
+    as_finite_array,
+    as_float_array,
+    check_dataset,
+    check_instance,
+    check_positive,
+    check_real,
+)
+
 __all__ = ["stage_onset", "onset_counts", "CentroidClassifier", "SlipDetector", "evaluate_slip"]
 
 
 def stage_onset(ds: xr.Dataset, label: str) -> np.ndarray:
     """Start (s) of stage ``label`` per condition; NaN-free: raises if a condition lacks it."""
+    check_dataset(ds)
+    check_instance(label, "label", str, "a stage label (str)")
     if "stage" not in ds.coords or label not in ds.stage.values:
-        raise ValueError(f"the dataset has no stage {label!r}; stages: {list(ds.coords.get('stage', []).values)}")
+        raise ValueError(f"label: the dataset has no stage {label!r}; "
+                         f"stages: {list(ds.coords.get('stage', []).values)}")
     k = int(np.flatnonzero(ds.stage.values == label)[0])
     start = ds.stage_start.values[:, k]
     if not np.all(np.isfinite(start)):
@@ -45,11 +57,15 @@ def onset_counts(ds: xr.Dataset, onset_s, window_s: float) -> np.ndarray:
     >>> onset_counts(ds, [0.1], 0.05).shape
     (1, 1, 1)
     """
-    if not window_s > 0:
-        raise ValueError(f"window_s must be > 0 s, got {window_s!r}")
+    check_dataset(ds)
+    if not check_real(window_s, "window_s") > 0:
+        raise ValueError(f"window_s must be > 0 s, got {float(window_s)!r}")
     if "spike_time" not in ds:
         raise ValueError("decoding needs spike events; simulate with record including 'spikes'")
-    onset = np.broadcast_to(np.asarray(onset_s, dtype=float), (ds.sizes["condition"],))
+    onset = as_finite_array(onset_s, "onset_s")
+    if onset.size not in (1, ds.sizes["condition"]):
+        raise ValueError(f"onset_s must be one time or one per condition ({ds.sizes['condition']}), got {onset.size}")
+    onset = np.broadcast_to(onset.ravel(), (ds.sizes["condition"],))
     cond, trial, aff = (ds[v].values for v in ("spike_condition", "spike_trial", "spike_afferent"))
     rel = ds.spike_time.values - onset[cond]
     keep = (rel >= 0) & (rel < window_s)
@@ -75,8 +91,8 @@ class CentroidClassifier:
     """
 
     def __init__(self, shrinkage: float = 0.2):
-        if not 0.0 <= shrinkage <= 1.0:
-            raise ValueError(f"shrinkage must be in [0, 1], got {shrinkage!r}")
+        if not 0.0 <= check_real(shrinkage, "shrinkage") <= 1.0:
+            raise ValueError(f"shrinkage must be in [0, 1], got {float(shrinkage)!r}")
         self.shrinkage = float(shrinkage)
 
     def fit(self, X, y) -> "CentroidClassifier":
@@ -132,10 +148,11 @@ class SlipDetector:
 
     def __init__(self, window_s: float = 0.01, margin: float = 1.2, start_stage: str = "tangential_ramp",
                  learn_s: float = 0.03, settle_s: float = 0.05):
-        if not window_s > 0 or not margin > 0 or not learn_s > 0:
-            raise ValueError(f"window_s, margin and learn_s must be > 0; got {window_s!r}, {margin!r}, {learn_s!r}")
-        if not settle_s >= 0:
-            raise ValueError(f"settle_s must be >= 0 (s); got {settle_s!r}")
+        for name, value in (("window_s", window_s), ("margin", margin), ("learn_s", learn_s)):
+            check_positive(value, name)
+        if not check_real(settle_s, "settle_s") >= 0:
+            raise ValueError(f"settle_s must be >= 0 (s); got {float(settle_s)!r}")
+        check_instance(start_stage, "start_stage", str, "a stage label (str)")
         self.window_s, self.margin, self.start_stage = float(window_s), float(margin), start_stage
         self.learn_s, self.settle_s = float(learn_s), float(settle_s)
 
@@ -197,8 +214,7 @@ def evaluate_slip(times, slip, onset, duration) -> dict:
     pre-onset time.  ``accuracy`` is the fraction of trials judged right
     (slip detected after its onset; no-slip never detected).
     """
-    slip, onset, duration = np.asarray(slip, bool), np.asarray(onset, float), np.asarray(duration, float)
-    times = np.asarray(times, float)
+    times, slip, onset, duration = _slip_inputs(times, slip, onset, duration)
     after = slip[:, None] & (times >= onset[:, None]) & np.isfinite(times)
     early = slip[:, None] & (times < onset[:, None])
     false = ~slip[:, None] & np.isfinite(times)
@@ -209,3 +225,19 @@ def evaluate_slip(times, slip, onset, duration) -> dict:
             "latency_ms": float(np.median(latency) * 1e3) if latency.size else None,
             "latency_p90_ms": float(np.percentile(latency, 90) * 1e3) if latency.size else None,
             "false_alarms_per_s": float((early.sum() + false.sum()) / exposure)}
+
+
+def _slip_inputs(times, slip, onset, duration) -> tuple:
+    """`evaluate_slip`'s arguments as arrays, one row (or value) per condition; errors name the argument."""
+    times = as_float_array(times, "times", ndim=2)  # inf: never detected
+    n = times.shape[0]
+    slip = np.asarray(slip)
+    if slip.dtype.kind not in "biu" or slip.shape != (n,):
+        raise ValueError(f"slip must hold one bool per condition ({n}), got dtype {slip.dtype}, shape {slip.shape}")
+    slip = slip.astype(bool)
+    onset, duration = as_float_array(onset, "onset"), as_finite_array(duration, "duration")
+    if onset.size not in (1, n) or not np.all(np.isfinite(np.broadcast_to(onset.ravel(), (n,))[slip])):
+        raise ValueError(f"onset must be one finite time (s), or one per condition ({n}), where slip is True")
+    if duration.size not in (1, n) or np.any(duration <= 0):
+        raise ValueError(f"duration must be one time > 0 s, or one per condition ({n})")
+    return times, slip, np.broadcast_to(onset.ravel(), (n,)), np.broadcast_to(duration.ravel(), (n,))

@@ -39,6 +39,7 @@ from scipy import stats
 from scipy.optimize import minimize
 
 from ddmm.models.metrics import CONTACT_THRESHOLD
+from ddmm.utils.validation import as_finite_array, as_float_array, check_dataset
 
 __all__ = ["angular_error", "to_degrees", "contact_onset", "window_responses", "select_afferents",
            "check_training", "population_vector", "count_normalisation", "poisson_tuning", "poisson_decode",
@@ -56,7 +57,11 @@ def angular_error(a_deg, b_deg) -> np.ndarray:
     >>> angular_error([350.0, 10.0], [10.0, 200.0]).tolist()
     [20.0, 170.0]
     """
-    d = np.mod(np.asarray(a_deg, float) - np.asarray(b_deg, float), 360.0)
+    a, b = as_finite_array(a_deg, "a_deg"), as_finite_array(b_deg, "b_deg")
+    try:
+        d = np.mod(a - b, 360.0)
+    except ValueError:
+        raise ValueError(f"b_deg must match a_deg's shape {a.shape} (or broadcast to it), got {b.shape}") from None
     return np.minimum(d, 360.0 - d)
 
 
@@ -94,6 +99,7 @@ def window_responses(ds: xr.Dataset, window_s: float, *, start_s: float | None =
     counts : ndarray of int, shape (condition, trial, afferent)
     latency : ndarray of float, same shape; ``window_s`` where no spike came (censored), in s
     """
+    check_dataset(ds)
     if not (isinstance(window_s, (int, float)) and window_s > 0):
         raise ValueError(f"window_s must be > 0 s, got {window_s!r}")
     if start_s is not None and not (isinstance(start_s, (int, float)) and 0 <= start_s < np.inf):
@@ -120,7 +126,14 @@ def window_responses(ds: xr.Dataset, window_s: float, *, start_s: float | None =
 
 def select_afferents(ds: xr.Dataset, positions) -> xr.Dataset:
     """The dataset restricted to afferents at ``positions``, spike events remapped."""
-    positions = np.asarray(positions, dtype=np.int64)
+    check_dataset(ds)
+    index = as_float_array(positions, "positions")
+    bad = (index < 0) | (index >= ds.sizes["afferent"]) | (index != np.floor(index))
+    if index.ndim != 1 or np.any(bad):
+        shown = f"shape {index.shape}" if index.ndim != 1 else f"{float(index[bad][0])!r}"
+        raise ValueError(f"positions must be a 1-D list of afferent positions in [0, {ds.sizes['afferent']}), "
+                         f"got {shown}")
+    positions = index.astype(np.int64)
     out = ds.isel(afferent=positions)
     if "spike_afferent" in ds:
         remap = np.full(ds.sizes["afferent"], -1, np.int64)

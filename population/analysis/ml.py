@@ -52,6 +52,7 @@ from ddmm.population.analysis.decode import (
     window_responses,
 )
 from ddmm.population.spec import NAP_CHOICES
+from ddmm.utils.validation import as_float_array
 
 __all__ = ["features", "example_features", "circular_score", "PopulationVectorDecoder", "MaximumLikelihoodDecoder",
            "FirstSpikeLatencyDecoder", "ESTIMATORS", "expected_failed_checks"]
@@ -183,8 +184,8 @@ def circular_score(y_true, y_pred, *, sample_weight=None) -> float:
     >>> round(circular_score([0.0, 90.0], [10.0, 60.0], sample_weight=[3, 1]), 3)
     0.955
     """
-    y_true = column_or_1d(np.asarray(y_true, float))
-    y_pred = column_or_1d(np.asarray(y_pred, float))
+    y_true = column_or_1d(as_float_array(y_true, "y_true"))
+    y_pred = column_or_1d(as_float_array(y_pred, "y_pred"))
     check_consistent_length(y_true, y_pred, sample_weight)
     for name, v in (("y_true", y_true), ("y_pred", y_pred)):
         if v.size == 0 or not np.isfinite(v).all():

@@ -50,6 +50,8 @@ from ddmm.population.analysis.physiology_core import (  # noqa: F401
     shipped_scenes,
     vibration_scene,
 )
+from ddmm.population.sampling import Population
+from ddmm.utils.validation import check_instance
 
 __all__ = ["Reference", "Property", "PROPERTIES", "PROTOCOLS", "shipped_scenes", "score_physiology",
            "summarise_scorecard"]
@@ -172,6 +174,8 @@ def score_physiology(population, references: dict, *, properties=None, seed: int
     ValueError
         For an unknown property, a missing reference, or a population lacking a type a property needs.
     """
+    check_instance(population, "population", Population, "a Population (e.g. from sample_population)")
+    check_instance(references, "references", dict, "a dict of Reference by property name (PHYSIOLOGY_REFERENCE)")
     names = _select(population, properties)
     missing = [n for n in names if n not in references]
     if missing:
@@ -210,6 +214,9 @@ def summarise_scorecard(rows) -> str:
     ...                      {"name": "b", "role": "held out", "pass": False}])
     'physiology: 1/2 properties pass (fitted 1/1, held out 0/1); failing: b'
     """
+    if not isinstance(rows, (list, tuple)) or not all(isinstance(row, dict) for row in rows):
+        raise TypeError(f"rows must be a list of scorecard rows (dicts, from score_physiology), got "
+                        f"{type(rows).__name__}")
     roles = {}
     for row in rows:
         n, k = roles.get(row["role"], (0, 0))

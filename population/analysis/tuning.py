@@ -36,6 +36,7 @@ import xarray as xr
 from ddmm.models.afferent_types import AFFERENT_TYPES
 from ddmm.models.metrics import direction_index
 from ddmm.population.stimuli.scenes import birznieks
+from ddmm.utils.validation import check_dataset, check_real
 
 __all__ = ["TUNING_DIRECTIONS", "DEFAULT_TRIALS", "RECORDED_TYPES", "tuning_scenes", "phase_counts", "tuned_criterion",
            "direction_tuning",
@@ -135,8 +136,9 @@ def direction_tuning(ds: xr.Dataset, *, alpha: float = 0.05, correction: str = "
         ``p_loading``, ``p_plateau`` (ANOVA p-values), ``tuned`` and
         ``responsive`` (0/1), ``dsi`` (eq. 7) and ``preferred_deg``.
     """
-    if not 0 < alpha < 1:
-        raise ValueError(f"alpha must be in (0, 1), got {alpha!r}")
+    check_dataset(ds)
+    if not 0 < check_real(alpha, "alpha") < 1:
+        raise ValueError(f"alpha must be in (0, 1), got {float(alpha)!r}")
     if correction not in ("none", "bonferroni"):
         raise ValueError(f"correction={correction!r} is not allowed; allowed: none, bonferroni")
     if ds.sizes["trial"] < 2 or ds.sizes["condition"] < 2:
@@ -170,6 +172,10 @@ def tuning_summary(tuning: xr.Dataset) -> dict:
     FA-I; no FA-II), the like-for-like comparison.  A type absent from the
     data (or with no responsive afferent) is reported as ``"absent"``.
     """
+    check_dataset(tuning, "tuning")
+    missing = [v for v in ("responsive", "tuned", "dsi", "afferent_type") if v not in tuning.variables]
+    if missing:
+        raise ValueError(f"tuning must be a direction_tuning result; it has no {missing[0]!r}")
     resp = tuning.responsive.values == 1
     types = tuning.afferent_type.values
     fractions, dsi, counts = {}, {}, {}

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ddmm.utils.deprecation import renamed_keyword
-from ddmm.utils.validation import shown
+from ddmm.utils.validation import as_float_array, check_count, check_instance, check_real, check_rng, shown
 
 __all__ = ["Ellipse", "Polygon", "HandRegion", "KINDS", "TYPES", "DENSITY_PER_CM2", "TYPE_SHARE",
            "REGIONS", "region_names", "get_region", "region_at", "sample_in_region", "region_counts",
@@ -65,7 +65,7 @@ def _rotation(deg: float) -> np.ndarray:
 
 
 def _xy(x_mm, y_mm, name="x_mm, y_mm"):
-    x, y = np.asarray(x_mm, dtype=float), np.asarray(y_mm, dtype=float)
+    x, y = as_float_array(x_mm, "x_mm"), as_float_array(y_mm, "y_mm")
     if x.shape != y.shape:
         raise ValueError(f"{name}: x_mm and y_mm must have the same shape, got {x.shape} and {y.shape}")
     return x, y
@@ -217,8 +217,11 @@ class HandRegion:
     frame_deg: float = 0.0
 
     def __post_init__(self):
+        check_instance(self.name, "name", str, "a str")
         if self.kind not in KINDS:
             raise ValueError(f"kind={self.kind!r} is unknown; allowed: {', '.join(KINDS)}")
+        check_instance(self.shape, "shape", (Ellipse, Polygon), "an Ellipse or a Polygon")
+        check_real(self.frame_deg, "frame_deg", "degrees")
 
     @property
     def area_mm2(self) -> float:
@@ -373,7 +376,7 @@ def sample_in_region(name: str, n: int, rng=None) -> np.ndarray:
     region = get_region(name)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
         raise ValueError(f"n must be a whole number >= 0, got {shown(n)}")
-    return region.shape.sample(int(n), np.random.default_rng(rng))
+    return region.shape.sample(int(n), check_rng(rng))
 
 
 def _largest_remainder(total: int, shares: dict) -> dict:
@@ -406,6 +409,9 @@ def region_counts(afferent_types=TYPES, regions=None) -> dict:
     >>> region_counts(regions=["D2d"])
     {'D2d': {'SAI': 238, 'RAI': 479, 'RAII': 71, 'SAII': 30}}
     """
+    for name, value in (("afferent_types", afferent_types), ("regions", () if regions is None else regions)):
+        if not hasattr(value, "__iter__"):  # a str is refused below, with the names allowed
+            raise TypeError(f"{name} must be a sequence of names, got {type(value).__name__}")
     bad = [t for t in afferent_types if t not in TYPES]
     if bad or isinstance(afferent_types, str):
         raise ValueError(f"afferent_types={afferent_types!r}: allowed afferent_types are {', '.join(TYPES)}")
@@ -442,4 +448,4 @@ def outline(name: str, n: int = 73) -> np.ndarray:
     >>> outline("D2d").shape
     (73, 2)
     """
-    return get_region(name).shape.outline(n)
+    return get_region(name).shape.outline(check_count(n, "n", minimum=3))

@@ -47,7 +47,8 @@ from __future__ import annotations
 import numpy as np
 
 from ddmm.models.afferent_types import AFFERENT_TYPES
-from ddmm.population.stimuli.scenes import Contact
+from ddmm.population.stimuli.scenes import Contact, Sites
+from ddmm.utils.validation import as_finite_array, check_instance
 
 __all__ = ["RF_AREA_MM2", "RF_SIGMA_MM", "RF_SUPPORT", "RF_SHAPES", "RF_TAIL_FLOOR", "REFERENCE_AREA_MM2",
            "receptive_field_weight", "population_weight", "site_weights", "local_mixing", "site_coverage", "frame_theta"]
@@ -118,12 +119,30 @@ def receptive_field_weight(x_mm, y_mm, afferent_type, contact, shape: str = "gau
     [1.0, 0.607, 0.011]
     """
     check_shape(shape)
-    x = np.asarray(x_mm, dtype=float)
-    y = np.asarray(y_mm, dtype=float)
+    check_instance(contact, "contact", Contact, "a Contact")
+    sigma, x, y = _afferents(x_mm, y_mm, afferent_type)
+    return _weight(sigma, x, y, contact, shape)
+
+
+def _afferents(x_mm, y_mm, afferent_type) -> tuple:
+    """(receptive-field width, x, y) of each afferent, mm; errors name the argument."""
+    x, y = as_finite_array(x_mm, "x_mm"), as_finite_array(y_mm, "y_mm")
     types = np.asarray(afferent_type, dtype=object)
-    sigma = np.empty(x.shape)
+    try:
+        x, y, types = np.broadcast_arrays(x, y, types)
+    except ValueError:
+        raise ValueError(f"x_mm, y_mm and afferent_type must have one entry per afferent each, got shapes "
+                         f"{x.shape}, {y.shape} and {types.shape}") from None
+    sigma = np.full(x.shape, np.nan)
     for kind in AFFERENT_TYPES:
         sigma[types == kind] = RF_SIGMA_MM[kind]
+    if np.isnan(sigma).any():
+        bad = types[np.isnan(sigma)].flat[0]
+        raise ValueError(f"afferent_type={bad!r} is unknown; allowed: {', '.join(AFFERENT_TYPES)}")
+    return sigma, x, y
+
+
+def _weight(sigma, x, y, contact, shape: str) -> np.ndarray:
     excess = np.maximum(np.hypot(x - contact.x_mm, y - contact.y_mm) - contact.radius_mm, 0.0)
     return _falloff(excess, sigma, shape)
 
@@ -141,10 +160,13 @@ def site_weights(x_mm, y_mm, afferent_type, sites, shape: str = "gaussian") -> n
     >>> w.round(3).tolist()
     [[1.0, 0.0], [0.0, 1.0]]
     """
-    out = np.empty((np.size(x_mm), len(sites)))
+    check_shape(shape)
+    check_instance(sites, "sites", Sites, "a Sites")
+    sigma, x, y = _afferents(x_mm, y_mm, afferent_type)
+    out = np.empty((x.size, len(sites)))
     for s in range(len(sites)):
         disc = Contact(float(sites.x_mm[s]), float(sites.y_mm[s]), float(sites.radius_mm[s]))
-        out[:, s] = receptive_field_weight(x_mm, y_mm, afferent_type, disc, shape)
+        out[:, s] = _weight(sigma, x, y, disc, shape)
     return out
 
 
@@ -187,6 +209,7 @@ def site_coverage(population, sites) -> np.ndarray:
         If a site reaches no afferent of the population (it lies outside
         every region the population covers), naming the site.
     """
+    _check_population(population)
     w = site_weights(population.x_mm, population.y_mm, population.afferent_type, sites, population.receptive_field)
     dead = np.flatnonzero(~np.any(w > 0.0, axis=0))
     if dead.size:
@@ -204,4 +227,11 @@ def frame_theta(population) -> np.ndarray:
     scene's force acts in every afferent's own digit frame, so it uses
     theta_T alone.
     """
+    _check_population(population)
     return population.theta_t + population.frame_deg
+
+
+def _check_population(population) -> None:
+    from ddmm.population.sampling import Population  # sampling imports this module
+
+    check_instance(population, "population", Population, "a Population (from sample_population or make_population)")

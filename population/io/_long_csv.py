@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.utils.validation import parse_number
+from ddmm.utils.validation import check_path, parse_number
 
 __all__ = ["TIME_TOL", "read_sites_csv", "read_long_forces", "uniform_grid"]
 
@@ -55,6 +55,7 @@ def _cell_float(where: str, col: str, line: int, text: str) -> float:
 
 def read_sites_csv(path):
     """Sites table: ``site,x_mm,y_mm[,region][,radius_mm]``; returns (Sites fields, line of each site)."""
+    check_path(path)
     where, index, rows = _csv_rows(path, "sites", ("site", "x_mm", "y_mm"), ("region", "radius_mm"))
     ids, lines, x, y, region, radius = [], {}, [], [], [], []
     for line, row in rows:

@@ -27,19 +27,29 @@ are not safety limits, which are the table's own.
 Files: CSV with a header (any column order; ``id`` and the six limits
 required; ``x_mm, y_mm, radius_mm`` or ``region``; optional
 ``interphase_us``) or TOML (``[[electrode]]`` entries with the same keys).
-Errors name the file, the row (line) and the field.
+Field names ignore case, and a name given twice (``ID`` beside ``id``, say)
+is refused, never merged.  Ids and region names print on one line
+(`MAX_NAME_CHARS` printable characters at most, no control characters), as
+``ddmm stimulate`` prints a line per electrode.  A table file holds at most
+`MAX_TABLE_BYTES` bytes and a CSV line at most `MAX_LINE_CHARS` characters:
+far more than any interface needs (about 100 bytes a row).  Errors name the
+file, the row (line) and the field.
 """
 
 from __future__ import annotations
 
+import csv
+import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ddmm.utils.validation import check_path
+
 __all__ = ["Electrode", "ElectrodeTable", "read_electrodes", "MAX_AMPLITUDE_UA", "MAX_PHASE_WIDTH_US",
-           "MAX_RATE_HZ", "MAX_CHARGE_NC"]
+           "MAX_RATE_HZ", "MAX_CHARGE_NC", "MAX_NAME_CHARS", "MAX_TABLE_BYTES", "MAX_LINE_CHARS"]
 
 #: Sanity bounds (unit slips, not safety limits): 20 mA, 10 ms, 2 kHz, 10 µC.
 MAX_AMPLITUDE_UA, MAX_PHASE_WIDTH_US, MAX_RATE_HZ, MAX_CHARGE_NC = 20_000.0, 10_000.0, 2_000.0, 10_000.0
@@ -47,6 +57,10 @@ _LIMITS = ("amplitude_min_ua", "amplitude_max_ua", "phase_width_us", "max_rate_h
 _BOUNDS = {"amplitude_min_ua": MAX_AMPLITUDE_UA, "amplitude_max_ua": MAX_AMPLITUDE_UA,
            "phase_width_us": MAX_PHASE_WIDTH_US, "max_rate_hz": MAX_RATE_HZ, "charge_limit_nc": MAX_CHARGE_NC,
            "interphase_us": MAX_PHASE_WIDTH_US, "radius_mm": 200.0}
+#: Longest id or region name, characters: each is printed in a line per electrode.
+MAX_NAME_CHARS = 64
+#: Largest table file, bytes (1 MiB), and longest CSV line, characters: a row needs about 100.
+MAX_TABLE_BYTES, MAX_LINE_CHARS = 1 << 20, 4096
 
 
 @dataclass(frozen=True)
@@ -92,9 +106,8 @@ class Electrode:
     interphase_us: float = 0.0
 
     def __post_init__(self):
+        _check_name("electrode id", self.id)
         where = f"electrode {self.id!r}"
-        if not isinstance(self.id, str) or not self.id.strip():
-            raise ValueError(f"electrode id must be a non-empty string, got {self.id!r}")
         for name in (*_LIMITS, "interphase_us"):
             _number(where, name, getattr(self, name), allow_zero=name == "interphase_us")
         _field_kind(where, self)
@@ -134,13 +147,32 @@ def _number(where: str, name: str, value, allow_zero: bool = False) -> None:
         raise ValueError(f"{where}: {name} = {float(value):g} is beyond {_BOUNDS[name]:g} (a unit slip?)")
 
 
+def _short(value) -> str:
+    """``repr`` of a value for a message, cut to 40 characters (an id may be megabytes long)."""
+    if isinstance(value, str) and len(value) > 40:
+        return repr(value[:40]) + "..."
+    return repr(value)
+
+
+def _check_name(what: str, value) -> None:
+    """An id or region name must print as one short line: it is printed in a line per electrode."""
+    if not isinstance(value, str) or not value.strip():
+        raise ValueError(f"{what} must be a non-empty string, got {_short(value)}")
+    if len(value) > MAX_NAME_CHARS:
+        raise ValueError(f"{what} must be at most {MAX_NAME_CHARS} characters, got {len(value):,} "
+                         f"({_short(value)})")
+    bad = next((c for c in value if not c.isprintable()), None)
+    if bad is not None:  # newlines, control, format and separator characters could forge or hide output
+        raise ValueError(f"{what} {_short(value)} holds the unprintable character U+{ord(bad):04X}: it must print "
+                         "on one line (letters, digits, punctuation and spaces)")
+
+
 def _field_kind(where: str, e: Electrode) -> str:
     disc = [e.x_mm, e.y_mm, e.radius_mm]
     if e.region is not None and any(v is not None for v in disc):
         raise ValueError(f"{where}: give a disc field (x_mm, y_mm, radius_mm) or a region, not both")
     if e.region is not None:
-        if not isinstance(e.region, str) or not e.region.strip():
-            raise ValueError(f"{where}: region must be a non-empty region name, got {e.region!r}")
+        _check_name(f"{where}: region", e.region)
         return "region"
     if any(v is None for v in disc):
         raise ValueError(f"{where}: a field needs x_mm, y_mm and radius_mm (or a region)")
@@ -168,6 +200,8 @@ class ElectrodeTable:
     """
 
     def __init__(self, electrodes):
+        if not hasattr(electrodes, "__iter__"):
+            raise TypeError(f"electrodes must be a non-empty sequence of Electrode, got {type(electrodes).__name__}")
         electrodes = list(electrodes)
         if not electrodes or not all(isinstance(e, Electrode) for e in electrodes):
             raise TypeError("electrodes must be a non-empty sequence of Electrode")
@@ -214,7 +248,7 @@ def _from_row(where: str, row: dict) -> Electrode:
         raise ValueError(f"{where}: field {missing[0]!r} is missing")
     unknown = sorted(set(row) - set(_TYPES))
     if unknown:
-        raise ValueError(f"{where}: unknown field {unknown[0]!r}; allowed: {', '.join(_TYPES)}")
+        raise ValueError(f"{where}: unknown field {_short(unknown[0])}; allowed: {', '.join(_TYPES)}")
     values = {}
     for key, text in row.items():
         if text in (None, ""):
@@ -225,7 +259,7 @@ def _from_row(where: str, row: dict) -> Electrode:
         try:
             values[key] = _float(text)
         except ValueError:
-            raise ValueError(f"{where}: field {key!r}: {text!r} is not a number") from None
+            raise ValueError(f"{where}: field {key!r}: {_short(text)} is not a number") from None
     try:
         return Electrode(**values)
     except ValueError as exc:
@@ -245,6 +279,14 @@ def _float(text) -> float:
 def read_electrodes(path) -> ElectrodeTable:
     """Read an electrode table from CSV or TOML (module docstring for the fields).
 
+    Raises
+    ------
+    ValueError
+        Naming the file (and the line or entry, and the field) for a table that
+        is not one: a field missing, unknown or given twice, a limit out of
+        range or contradicting another, an unprintable or overlong id, a file
+        over `MAX_TABLE_BYTES` or a CSV line over `MAX_LINE_CHARS`.
+
     Examples
     --------
     >>> import tempfile, pathlib
@@ -255,14 +297,11 @@ def read_electrodes(path) -> ElectrodeTable:
     ...     read_electrodes(p).ids
     ['E1']
     """
-    path = Path(path)
+    path = check_path(path)
     where = f"electrode table {str(path)!r}"
     if path.suffix.lower() not in (".csv", ".toml"):
         raise ValueError(f"{where}: expected a .csv or .toml file")
-    try:
-        text = path.read_bytes().decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise ValueError(f"{where}: not UTF-8 text (byte {exc.start})") from None
+    text = _read_text(where, path)
     rows = _csv_rows(where, text) if path.suffix.lower() == ".csv" else _toml_rows(where, text)
     if not rows:
         raise ValueError(f"{where}: no electrodes")
@@ -273,20 +312,57 @@ def read_electrodes(path) -> ElectrodeTable:
         raise ValueError(f"{where}: {exc}") from None
 
 
-def _csv_rows(where: str, text: str) -> list:
-    import csv
+def _read_text(where: str, path: Path) -> str:
+    """The file's text, refusing before reading it whole a file larger than any table (a sparse 1 GiB file, say)."""
+    size, data = path.stat().st_size, b""
+    if size <= MAX_TABLE_BYTES:
+        with path.open("rb") as f:
+            data = f.read(MAX_TABLE_BYTES + 1)  # a pipe or a growing file has no size to trust
+        size = max(size, len(data))
+    if size > MAX_TABLE_BYTES:
+        raise ValueError(f"{where}: larger than the {MAX_TABLE_BYTES:,} bytes an electrode table may hold (a row "
+                         "needs about 100)")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{where}: not UTF-8 text (byte {exc.start})") from None
 
-    lines = list(csv.reader(text.splitlines()))
-    if not lines:
-        return []
-    header = [h.strip().lower() for h in lines[0]]
-    rows = []
-    for number, cells in enumerate(lines[1:], start=2):
-        if not any(c.strip() for c in cells):
-            continue
-        if len(cells) != len(header):
-            raise ValueError(f"{where}, line {number}: {len(cells)} fields, the header has {len(header)}")
-        rows.append((f"line {number}", dict(zip(header, (c.strip() for c in cells)))))
+
+def _unique_names(where: str, names, kind: str) -> list:
+    """Field names, stripped and lower-cased; a name given twice (in any case) is refused, never merged."""
+    seen, out = {}, []
+    for position, raw in enumerate(map(str, names), start=1):
+        key = raw.strip().lower()
+        if key in seen:
+            where_first = f"{kind} {seen[key][0]} " if kind == "column" else ""
+            where_again = f"{kind} {position} " if kind == "column" else ""
+            raise ValueError(f"{where}: field {_short(key)} is given twice ({where_first}{_short(seen[key][1])} and "
+                             f"{where_again}{_short(raw)}; names ignore case)")
+        seen[key] = (position, raw)
+        out.append(key)
+    return out
+
+
+def _csv_rows(where: str, text: str) -> list:
+    # Lines keep their ends, as csv wants: a quoted newline stays in its field (and an id refuses it).
+    lines = io.StringIO(text, newline="").readlines()
+    for number, line in enumerate(lines, start=1):
+        length = len(line.rstrip("\r\n"))
+        if length > MAX_LINE_CHARS:
+            raise ValueError(f"{where}, line {number}: {length:,} characters, more than the {MAX_LINE_CHARS:,} a "
+                             "table's line may hold")
+    reader, rows, start, header = csv.reader(lines), [], 1, None
+    try:
+        for cells in reader:
+            if header is None:
+                header = _unique_names(f"{where}, line 1", cells, "column")
+            elif any(c.strip() for c in cells):
+                if len(cells) != len(header):
+                    raise ValueError(f"{where}, line {start}: {len(cells)} fields, the header has {len(header)}")
+                rows.append((f"line {start}", dict(zip(header, (c.strip() for c in cells)))))
+            start = reader.line_num + 1  # a quoted field may span lines: the next row starts after this one
+    except csv.Error as exc:
+        raise ValueError(f"{where}, line {start}: not valid CSV ({exc}: is a quote left open?)") from None
     return rows
 
 
@@ -299,9 +375,9 @@ def _toml_rows(where: str, text: str) -> list:
         raise ValueError(f"{where}: not valid TOML ({str(exc).splitlines()[0] if str(exc) else 'too deep'})") from None
     extra = sorted(set(data) - {"electrode"})
     if extra:
-        raise ValueError(f"{where}: unknown table {extra[0]!r}; electrodes go in [[electrode]] entries")
+        raise ValueError(f"{where}: unknown table {_short(extra[0])}; electrodes go in [[electrode]] entries")
     entries = data.get("electrode", [])
     if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
         raise ValueError(f"{where}: electrodes go in [[electrode]] entries")
-    return [(f"electrode {i + 1}", {str(k).lower(): v for k, v in e.items()}) for i, e in enumerate(entries)]
-
+    return [(f"electrode {i + 1}", dict(zip(_unique_names(f"{where}, electrode {i + 1}", e, "key"), e.values())))
+            for i, e in enumerate(entries)]

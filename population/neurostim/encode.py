@@ -20,6 +20,8 @@ The pulses Dataset (names fixed):
 from __future__ import annotations
 
 import dataclasses
+import os
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +33,7 @@ from ddmm.population.neurostim.electrodes import ElectrodeTable, read_electrodes
 from ddmm.population.neurostim.pulses import PulseKernel, contact_weights, field_weights
 from ddmm.population.neurostim.rules import get_rule
 from ddmm.utils.files import read_netcdf, write_netcdf
+from ddmm.utils.validation import check_dataset
 
 __all__ = ["stimulation_pulses", "check_pulses", "save_pulses", "load_pulses", "as_table", "WAVEFORM"]
 
@@ -42,27 +45,64 @@ def as_table(electrodes) -> ElectrodeTable:
     """An `ElectrodeTable` from a table, a sequence of `Electrode` or a CSV/TOML path."""
     if isinstance(electrodes, ElectrodeTable):
         return electrodes
-    if isinstance(electrodes, (str, Path)):
+    if isinstance(electrodes, (str, os.PathLike)):
         return read_electrodes(electrodes)
+    if not hasattr(electrodes, "__iter__"):
+        raise TypeError(f"electrodes must be an ElectrodeTable, a sequence of Electrode or a CSV/TOML path, got "
+                        f"{type(electrodes).__name__}")
     return ElectrodeTable(electrodes)
 
 
-def _field_forces(ds, table) -> np.ndarray:
-    """(condition, time, electrode): the normal force under each field, N (module docstring of `pulses`)."""
+def _field_forces(ds, table):
+    """(condition, time, electrode): the normal force under each field, N (module docstring of `pulses`), and
+    (electrode,): whether each field takes part of a site or contact disc (the whole skin of a run without contact
+    geometry is no place: every field takes it)."""
     if "site" in ds.dims:
         if "site_fz" not in ds:
             raise ValueError("the dataset has sites but no per-site forces (site_fz): simulate with the forces "
                              "recorded")
         weights = field_weights(table, ds.site_x_mm.values, ds.site_y_mm.values, ds.site_radius_mm.values,
                                 ds.site_region.values)
-        return np.einsum("cts,es->cte", ds.site_fz.values, weights)
+        return np.einsum("cts,es->cte", ds.site_fz.values, weights), np.any(weights > 0, axis=1)
     if "fz" not in ds:
         raise ValueError("the dataset has no forces (fz): simulate with the forces recorded")
     n_c = ds.sizes["condition"]
     contact = ([ds[f"contact_{n}"].values for n in ("x_mm", "y_mm", "radius_mm")] if "contact_radius_mm" in ds.coords
                else [np.zeros(n_c), np.zeros(n_c), np.full(n_c, np.nan)])  # no contact: the whole skin
     weights = np.stack([contact_weights(table, *(float(v[c]) for v in contact)) for c in range(n_c)])
-    return ds.fz.values[:, :, None] * weights[:, None, :]
+    placed = np.isfinite(np.asarray(contact[2], float))
+    return ds.fz.values[:, :, None] * weights[:, None, :], np.any(weights[placed] > 0, axis=0)
+
+
+def _field_text(e) -> str:
+    return f"region {e.region!r}" if e.region is not None else f"disc ({e.x_mm:g}, {e.y_mm:g}) mm r {e.radius_mm:g}"
+
+
+def _check_reach(table, members, on_sites, population: str) -> None:
+    """Refuse a table none of whose fields reaches an afferent of the run or a force site; warn of each such field.
+
+    Such a table could only ever report 0 pulses.  An electrode whose field
+    reaches afferents but never sees contact reports 0 pulses and is no error.
+
+    Parameters
+    ----------
+    table : ElectrodeTable
+    members : list of ndarray
+        Per electrode, the afferents of the run inside its field (`ElectrodeTable.members`).
+    on_sites : array_like of bool
+        Per electrode, whether its field takes part of a force site or contact disc.
+    population : str
+        The run's population, for the message.
+    """
+    reached = np.array([len(m) > 0 for m in members]) | np.asarray(on_sites, bool)
+    lost = [f"{e.id!r} ({_field_text(e)})" for e, ok in zip(table, reached) if not ok]
+    shown = ", ".join(lost[:5]) + (f" and {len(lost) - 5} more" if len(lost) > 5 else "")
+    if not reached.any():
+        raise ValueError(f"no electrode of the table reaches an afferent of population {population!r} or a force "
+                         f"site: {shown}; every field lies outside the skin the run covers, so no pulse could start")
+    if lost:
+        warnings.warn(f"electrode(s) {shown} reach no afferent of population {population!r} and no force site: "
+                      "0 pulses there", UserWarning, stacklevel=3)
 
 
 def stimulation_pulses(dataset, electrodes, rule="biomimetic") -> xr.Dataset:
@@ -83,6 +123,13 @@ def stimulation_pulses(dataset, electrodes, rule="biomimetic") -> xr.Dataset:
     xarray.Dataset
         Pulses and traces (module docstring); `check_pulses` finds nothing in it.
 
+    Raises
+    ------
+    ValueError
+        If no field of the table reaches an afferent of the run or a force
+        site: it could only report 0 pulses.  A field that reaches neither,
+        beside others that do, is warned about and reports 0 pulses.
+
     Examples
     --------
     >>> from ddmm.population import birznieks, make_population, simulate
@@ -93,13 +140,15 @@ def stimulation_pulses(dataset, electrodes, rule="biomimetic") -> xr.Dataset:
     >>> bool(pulses.sizes["pulse"] > 0), check_pulses(pulses)
     (True, [])
     """
+    check_dataset(dataset, "dataset")
     table, rule = as_table(electrodes), get_rule(rule)
     if "spike_time" not in dataset:
         raise ValueError("the dataset has no spike events: simulate with the spikes recorded")
     fs, dt = float(dataset.attrs["fs"]), float(dataset.attrs["dt"])
     substeps = int(round(1.0 / (fs * dt)))
-    forces = _field_forces(dataset, table)
+    forces, on_sites = _field_forces(dataset, table)
     members = table.members(dataset.x_mm.values, dataset.y_mm.values, dataset.region.values)
+    _check_reach(table, members, on_sites, str(dataset.attrs.get("population", "")))
     weights = rule.type_weights(dataset.afferent_type.values)
     n_c, n_t = dataset.sizes["condition"], dataset.sizes["trial"]
     step = np.round(dataset.spike_time.values / dt).astype(np.int64)
@@ -168,6 +217,7 @@ def check_pulses(pulses: xr.Dataset) -> list:
     >>> check_pulses(load_pulses("pulses.nc"))  # doctest: +SKIP
     []
     """
+    check_dataset(pulses, "pulses")
     problems = []
     e = pulses.pulse_electrode.values
     amp, t = pulses.pulse_amplitude.values, pulses.pulse_time.values

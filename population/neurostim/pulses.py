@@ -27,6 +27,9 @@ import numba as nb
 import numpy as np
 
 from ddmm.models.metrics import CONTACT_THRESHOLD
+from ddmm.population.neurostim.electrodes import ElectrodeTable
+from ddmm.population.neurostim.rules import RULES
+from ddmm.utils.validation import check_instance, check_positive
 
 __all__ = ["PulseKernel", "field_weights", "contact_weights", "disc_overlap"]
 
@@ -54,6 +57,7 @@ def field_weights(table, x_mm, y_mm, radius_mm, region) -> np.ndarray:
     region starts with its name, whole.  A site with radius ``inf`` is the
     whole skin (every field takes all of it).
     """
+    check_instance(table, "table", ElectrodeTable, "an ElectrodeTable")
     x, y, r = (np.atleast_1d(np.asarray(v, float)) for v in (x_mm, y_mm, radius_mm))
     region = np.atleast_1d(np.asarray(region, dtype=object)).astype(str)
     out = np.zeros((len(table), x.size))
@@ -109,7 +113,11 @@ class PulseKernel:
     """
 
     def __init__(self, table, rule, fs: float, members, weights):
-        self.table, self.rule, self.fs = table, rule, float(fs)
+        check_instance(table, "table", ElectrodeTable, "an ElectrodeTable")
+        check_instance(rule, "rule", tuple(RULES.values()), f"a rule object ({', '.join(RULES)})")
+        if not hasattr(members, "__len__") or len(members) != len(table):
+            raise ValueError(f"members must hold one array of afferent positions per electrode ({len(table)})")
+        self.table, self.rule, self.fs = table, rule, check_positive(fs, "fs", "Hz")
         n_aff = int(np.asarray(weights).size)
         self._indptr, self._members, self._back_ptr, self._back = _csr(members, n_aff)
         self._weights = np.ascontiguousarray(weights, dtype=float)

@@ -32,6 +32,15 @@ contact threshold to ``amplitude_max_ua`` at ``force_sat_n`` under the field.
 **linear-frequency** (`LinearFrequency`): a fixed amplitude (``amplitude_fraction``
 of the way from the minimum to the maximum), rate rising linearly from 0 at the
 contact threshold to ``max_rate_hz`` at ``force_sat_n``.
+
+Settings outside their physical range are refused, with the range (`RANGES`):
+``tau_s`` and ``active_window_s`` in (0, 1] s (a smoothing or window longer
+than a touch could not follow one); ``rate_sat_hz`` in (0, 1000] spikes/s
+(no afferent sustains 1 kHz, so a higher saturation is never reached);
+``rate_hz`` in [1, 2000] Hz (below 1 Hz no pulse in a second of touch; 2 kHz
+the electrodes' own bound, `MAX_RATE_HZ`); ``force_sat_n`` in (0.05, 500] N
+(above the contact threshold, where the ramp starts; 500 N about the
+strongest human grip).  Weights must not all be 0.
 """
 
 from __future__ import annotations
@@ -42,17 +51,42 @@ from dataclasses import dataclass
 import numpy as np
 
 from ddmm.models.afferent_types import AFFERENT_TYPES as TYPES
+from ddmm.models.metrics import CONTACT_THRESHOLD
+from ddmm.population.neurostim.electrodes import MAX_RATE_HZ
 from ddmm.utils.validation import shown
 
-__all__ = ["Biomimetic", "LinearAmplitude", "LinearFrequency", "RULES", "get_rule"]
+__all__ = ["Biomimetic", "LinearAmplitude", "LinearFrequency", "RULES", "RANGES", "get_rule", "check_setting"]
+
+#: Physical range of each setting: (low, high, whether low itself is allowed); high is always allowed.
+RANGES = {"tau_s": (0.0, 1.0, False), "active_window_s": (0.0, 1.0, False), "active_sat": (0.0, 1.0, False),
+          "rate_sat_hz": (0.0, 1000.0, False), "rate_hz": (1.0, MAX_RATE_HZ, True),
+          "force_sat_n": (CONTACT_THRESHOLD, 500.0, False)}
+_UNITS = {"tau_s": "s", "active_window_s": "s", "active_sat": "", "rate_sat_hz": "spikes/s", "rate_hz": "Hz",
+          "force_sat_n": "N"}
 
 
-def _positive(rule: str, name: str, value, upper: float | None = None) -> None:
-    number = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if not number or not math.isfinite(value) or value <= 0 or (upper is not None and value > upper):
-        shown = f"{float(value):g}" if number else repr(value)
-        raise ValueError(f"{rule}: {name} must be a finite number > 0{'' if upper is None else f' and <= {upper:g}'}, "
-                         f"got {shown}")
+def check_setting(label: str, name: str, value, scale: float = 1.0, unit: str | None = None) -> None:
+    """Refuse a rule setting outside its range (`RANGES`), as the user wrote it.
+
+    ``value x scale`` is the setting in the rule's units; ``label`` and ``unit``
+    name it as the user wrote it (``"--tau"``, ``"ms"`` for ``tau_s``, scale
+    1e-3; the unit defaults to the rule's own).
+
+    Examples
+    --------
+    >>> check_setting("--tau", "tau_s", 1e15, 1e-3, "ms")
+    Traceback (most recent call last):
+    ...
+    ValueError: --tau must be a finite number in (0, 1000] ms, got 1e+15
+    """
+    low, high, closed = RANGES[name]
+    unit = _UNITS[name] if unit is None else unit
+    number = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    if number and math.isfinite(value) and (low <= value * scale if closed else low < value * scale) \
+            and value * scale <= high:
+        return
+    bounds = f"{'[' if closed else '('}{low / scale:g}, {high / scale:g}]{f' {unit}' if unit else ''}"
+    raise ValueError(f"{label} must be a finite number in {bounds}, got {f'{float(value):g}' if number else repr(value)}")
 
 
 @dataclass(frozen=True)
@@ -62,16 +96,16 @@ class Biomimetic:
     Attributes
     ----------
     tau_s : float
-        Time constant of the aggregate rate's smoothing, s.
+        Time constant of the aggregate rate's smoothing, s, in (0, 1].
     rate_sat_hz : float
         Aggregate rate (spikes/s per field afferent) at which the pulse rate
-        reaches the electrode's limit.
+        reaches the electrode's limit, in (0, 1000].
     active_window_s : float
-        An afferent is active for this long after each of its spikes, s.
+        An afferent is active for this long after each of its spikes, s, in (0, 1].
     active_sat : float
         Active fraction at which the amplitude reaches its maximum (0-1].
     weights : tuple of (str, float)
-        Weight of each type's spikes in the aggregate rate.
+        Weight of each type's spikes in the aggregate rate (>= 0, not all 0).
 
     Examples
     --------
@@ -88,14 +122,16 @@ class Biomimetic:
     code = 0
 
     def __post_init__(self):
-        for field in ("tau_s", "rate_sat_hz", "active_window_s"):
-            _positive(self.name, field, getattr(self, field))
-        _positive(self.name, "active_sat", self.active_sat, 1.0)
-        weights = dict(self.weights)
+        for field in ("tau_s", "rate_sat_hz", "active_window_s", "active_sat"):
+            check_setting(f"{self.name}: {field}", field, getattr(self, field))
+        try:
+            weights = dict(self.weights)
+        except (TypeError, ValueError):
+            raise TypeError(f"{self.name}: weights must be (type, weight) pairs, got {self.weights!r}") from None
         if set(weights) != set(TYPES) or any(not (isinstance(w, (int, float)) and math.isfinite(w) and w >= 0)
-                                             for w in weights.values()):
+                                             for w in weights.values()) or not any(weights.values()):
             raise ValueError(f"{self.name}: weights must give a finite weight >= 0 to each of {', '.join(TYPES)}, "
-                             f"got {self.weights!r}")
+                             f"not all 0 (no spike would count), got {self.weights!r}")
 
     def type_weights(self, afferent_type) -> np.ndarray:
         """The weight of each afferent's spikes."""
@@ -114,9 +150,10 @@ class LinearAmplitude:
     Attributes
     ----------
     rate_hz : float
-        Pulse rate in contact, Hz (each electrode's limit caps it).
+        Pulse rate in contact, Hz, in [1, 2000] (each electrode's limit caps it).
     force_sat_n : float
-        Force under the field at which the amplitude reaches its maximum, N.
+        Force under the field at which the amplitude reaches its maximum, N,
+        in (0.05, 500] (above the contact threshold).
 
     Examples
     --------
@@ -130,8 +167,8 @@ class LinearAmplitude:
     code = 1
 
     def __post_init__(self):
-        _positive(self.name, "rate_hz", self.rate_hz)
-        _positive(self.name, "force_sat_n", self.force_sat_n)
+        check_setting(f"{self.name}: rate_hz", "rate_hz", self.rate_hz)
+        check_setting(f"{self.name}: force_sat_n", "force_sat_n", self.force_sat_n)
 
     def type_weights(self, afferent_type) -> np.ndarray:
         """Unused by this rule (no afferent activity): ones."""
@@ -151,7 +188,8 @@ class LinearFrequency:
     amplitude_fraction : float
         Where the fixed amplitude sits between the electrode's minimum (0) and maximum (1).
     force_sat_n : float
-        Force under the field at which the rate reaches the electrode's limit, N.
+        Force under the field at which the rate reaches the electrode's limit,
+        N, in (0.05, 500] (above the contact threshold).
 
     Examples
     --------
@@ -168,7 +206,7 @@ class LinearFrequency:
         number = isinstance(self.amplitude_fraction, (int, float)) and not isinstance(self.amplitude_fraction, bool)
         if not number or not 0.0 <= self.amplitude_fraction <= 1.0:
             raise ValueError(f"{self.name}: amplitude_fraction must be in [0, 1], got {shown(self.amplitude_fraction)}")
-        _positive(self.name, "force_sat_n", self.force_sat_n)
+        check_setting(f"{self.name}: force_sat_n", "force_sat_n", self.force_sat_n)
 
     def type_weights(self, afferent_type) -> np.ndarray:
         """Unused by this rule (no afferent activity): ones."""

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.population.neurostim.encode import as_table
+from ddmm.population.neurostim.encode import _check_reach, as_table
 from ddmm.population.neurostim.pulses import PulseKernel, contact_weights, field_weights
 from ddmm.population.neurostim.rules import get_rule
 
@@ -57,6 +57,12 @@ class StimulationEncoder:
     rule : str or rule object
         As `stimulation_pulses`.
 
+    Raises
+    ------
+    ValueError
+        If no field of the table reaches an afferent the encoder simulates or
+        its contact or force sites (as `stimulation_pulses`).
+
     Examples
     --------
     >>> from ddmm.population import birznieks, make_population
@@ -72,14 +78,20 @@ class StimulationEncoder:
     """
 
     def __init__(self, encoder, electrodes, rule="biomimetic"):
+        from ddmm.population.runtime.stream import Encoder
+
+        if not isinstance(encoder, Encoder):
+            raise TypeError(f"encoder must be an Encoder (ddmm.population.runtime), got {type(encoder).__name__}")
         self.encoder, self.table, self.rule = encoder, as_table(electrodes), get_rule(rule)
         pop, positions = encoder.population, encoder.positions
         self._slot = np.full(len(pop), -1, np.int64)
         self._slot[positions] = np.arange(positions.size)  # spikes' population positions -> kernel axis
         members = self.table.members(pop.x_mm[positions], pop.y_mm[positions], pop.region[positions])
+        self._weights = self._site_weights()
+        placed = self.encoder.sites is not None or self.encoder.contact is not None  # else: the whole skin
+        _check_reach(self.table, members, np.any(self._weights > 0, axis=1) & placed, str(pop.name))
         self._kernel = PulseKernel(self.table, self.rule, encoder.model_fs, members,
                                    self.rule.type_weights(pop.afferent_type[positions]))
-        self._weights = self._site_weights()
         self._substeps = encoder.substeps
         self._width = self.table.column("phase_width_us")
 

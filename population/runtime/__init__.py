@@ -1,6 +1,8 @@
 """Runtime: how a run is carried out, beside the simulation core.
 
 - `plan`: what a run computes and what it skips (`make_plan`);
+- `memory`: a run's peak memory, spike events included, estimated before it
+  starts (`estimate_memory`), and the refusal of a run that cannot fit;
 - `noise`: counter-based current noise, keyed so chunking never changes it;
 - `stream`: the streaming encoder (`Encoder`), live force in, spikes out;
 - `step_choice`: the (dt, method) that meets an accuracy tolerance;

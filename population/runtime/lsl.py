@@ -30,7 +30,7 @@ import numpy as np
 
 from ddmm.population.stimuli.recordings import UNITS
 from ddmm.utils.extras import require
-from ddmm.utils.validation import check_positive, shown
+from ddmm.utils.validation import check_count, check_instance, check_positive, shown
 
 __all__ = ["SPIKE_STREAM_TYPE", "FORCE_STREAM_TYPE", "PULSE_STREAM_TYPE", "ForceStream", "ChunkReader",
            "open_force_stream", "open_force_outlet", "lsl_clock"]
@@ -202,6 +202,7 @@ def open_force_stream(name: str, *, n_sites: int = 1, fs: float | None = None, u
     >>> stream.unit, stream.fs  # doctest: +SKIP
     ('mN', 1000.0)
     """
+    check_instance(name, "name", str, "a str (the stream's LSL name)")
     pylsl = _pylsl("open_force_stream")
     timeout = check_positive(timeout, "timeout", "s")
     if isinstance(n_sites, bool) or not isinstance(n_sites, (int, np.integer)) or n_sites < 1:
@@ -247,6 +248,8 @@ def open_force_outlet(name: str, *, fs: float, n_sites: int = 1, units: str = "N
     --------
     >>> outlet = open_force_outlet("ddmm-doc-sensor", fs=100.0, units="mN")  # doctest: +SKIP
     """
+    check_instance(name, "name", str, "a str (the stream's LSL name)")
+    rate, n_sites = check_positive(fs, "fs", "Hz"), check_count(n_sites, "n_sites")
     pylsl = _pylsl("open_force_outlet")
     if units not in UNITS:
         raise ValueError(f"units={units!r} is not allowed; allowed: {', '.join(UNITS)}")
@@ -254,8 +257,7 @@ def open_force_outlet(name: str, *, fs: float, n_sites: int = 1, units: str = "N
     if sites is not None and len(sites) != n_sites:
         raise ValueError(f"site_ids must name {n_sites} site(s), got {len(sites)}")
     sid = source_id or "ddmm-force-" + hashlib.sha256(f"{name}/{fs}/{n_sites}/{units}".encode()).hexdigest()[:12]
-    info = pylsl.StreamInfo(name, FORCE_STREAM_TYPE, 3 * n_sites, check_positive(fs, "fs", "Hz"),
-                            pylsl.cf_double64, sid)
+    info = pylsl.StreamInfo(name, FORCE_STREAM_TYPE, 3 * n_sites, rate, pylsl.cf_double64, sid)
     channels = info.desc().append_child("channels")
     for site in range(n_sites):
         for axis in "xyz":

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ddmm.population.runtime.lsl import ChunkReader, ForceStream, _pylsl
-from ddmm.utils.validation import check_positive
+from ddmm.utils.validation import as_float_array, check_instance, check_positive, check_real
 
 __all__ = ["GAP_FACTOR", "BridgeSummary", "Bridge", "check_stamps", "play_forces"]
 
@@ -93,7 +93,10 @@ def check_stamps(stamps, last: float | None, fs: float):
     >>> keep.tolist(), excess.round(6).tolist()
     ([True, True, False, True], [0.0, 0.0, 0.0, 0.007])
     """
-    stamps = np.asarray(stamps, dtype=float)
+    stamps = as_float_array(stamps, "stamps", ndim=1)
+    fs = check_positive(fs, "fs", "Hz")
+    if last is not None:
+        check_real(last, "last", "s")
     keep, excess = np.ones(stamps.size, bool), np.zeros(stamps.size)
     previous = -np.inf if last is None else float(last)
     step = np.diff(np.r_[previous, stamps])
@@ -139,6 +142,10 @@ class Bridge:
     """
 
     def __init__(self, encoder, force: ForceStream, sink, *, report=None, stimulator=None, pulse_sink=None):
+        from ddmm.population.runtime.stream import Encoder
+
+        check_instance(encoder, "encoder", Encoder, "an Encoder")
+        check_instance(force, "force", ForceStream, "a ForceStream (from open_force_stream)")
         if (stimulator is None) != (pulse_sink is None) or (stimulator is not None and stimulator.encoder is not encoder):
             raise ValueError("stimulator and pulse_sink go together, and the stimulator must wrap this encoder")
         self.stimulator, self.pulse_sink = stimulator, pulse_sink
@@ -300,9 +307,11 @@ def play_forces(outlet, forces, fs: float, *, should_stop=None, start: float | N
     >>> play_forces(open_force_outlet("sensor", fs=100.0), np.zeros((100, 3)), 100.0)  # doctest: +SKIP
     100
     """
-    pylsl = _pylsl("play_forces")
-    forces = np.ascontiguousarray(forces, dtype=float)
+    if not callable(getattr(outlet, "push_chunk", None)):
+        raise TypeError(f"outlet must be a pylsl.StreamOutlet (from open_force_outlet), got {type(outlet).__name__}")
+    forces = np.ascontiguousarray(as_float_array(forces, "forces", ndim=2))
     fs = check_positive(fs, "fs", "Hz")
+    pylsl = _pylsl("play_forces")
     t0 = pylsl.local_clock() if start is None else float(start)
     for k in range(forces.shape[0]):
         due = t0 + k / fs

@@ -28,6 +28,7 @@ import hashlib
 import numpy as np
 
 from ddmm.population.runtime.lsl import PULSE_STREAM_TYPE, SPIKE_STREAM_TYPE, ForceStream, _handle_error, _pylsl
+from ddmm.utils.validation import check_instance
 
 __all__ = ["SpikeOutlet", "PulseOutlet", "read_spike_metadata"]
 
@@ -60,6 +61,11 @@ class SpikeOutlet:
     """
 
     def __init__(self, name: str, encoder, *, force: ForceStream | None = None, source_id: str | None = None):
+        from ddmm.population.runtime.stream import Encoder
+
+        check_instance(name, "name", str, "a str (the stream's LSL name)")
+        check_instance(encoder, "encoder", Encoder, "an Encoder")
+        check_instance(force, "force", (ForceStream, type(None)), "a ForceStream or None")
         pylsl = _pylsl("SpikeOutlet")
         ids = encoder.population.afferent_id[encoder.positions]
         digest = hashlib.sha256(f"{name}/{encoder.population.name}/{encoder.seed}/{_text(ids)}".encode())
@@ -115,6 +121,10 @@ class PulseOutlet:
     """
 
     def __init__(self, name: str, stimulator, *, source_id: str | None = None):
+        from ddmm.population.neurostim.stream import StimulationEncoder
+
+        check_instance(name, "name", str, "a str (the stream's LSL name)")
+        check_instance(stimulator, "stimulator", StimulationEncoder, "a StimulationEncoder")
         pylsl = _pylsl("PulseOutlet")
         table = stimulator.table
         digest = hashlib.sha256(f"{name}/{_text(table.ids)}/{stimulator.rule!r}".encode())
@@ -203,6 +213,8 @@ def read_spike_metadata(info) -> dict:
     >>> inlet = pylsl.StreamInlet(pylsl.resolve_byprop("type", "Spikes")[0])  # doctest: +SKIP
     >>> meta = read_spike_metadata(inlet.info())  # doctest: +SKIP
     """
+    if not callable(getattr(info, "desc", None)):
+        raise TypeError(f"info must be a pylsl.StreamInfo (e.g. inlet.info()), got {type(info).__name__}")
     desc = info.desc()
     if desc.child("afferents").empty():
         raise ValueError(f"LSL stream {info.name()!r} carries no ddmm population description")

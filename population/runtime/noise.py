@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from ddmm.models.rng import normals, stream_key
+from ddmm.utils.validation import check_count
 
 __all__ = ["noise_key", "draw_noise", "noise_current", "root_seed"]
 
@@ -58,6 +59,8 @@ def noise_key(seed: int, condition: int, trial: int) -> int:
     >>> noise_key(1, 0, 0) == noise_key(1, 0, 0) != noise_key(1, 0, 1)
     True
     """
+    for name, value in (("seed", seed), ("condition", condition), ("trial", trial)):
+        check_count(value, name, minimum=0)
     return stream_key(seed, condition, trial)
 
 

@@ -35,8 +35,10 @@ from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.models.attenuation import F_TH, UNTUNED
 from ddmm.models.variability import bias_multiplier
 from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
+from ddmm.population.sampling import Population
+from ddmm.population.stimuli.scenes import as_scenes
 from ddmm.utils.deprecation import renamed_keyword, warn_renamed
-from ddmm.utils.validation import check_choice
+from ddmm.utils.validation import check_choice, check_count, check_instance
 
 __all__ = ["RECORD_CHOICES", "ConditionPlan", "Plan", "af_threshold", "make_plan"]
 
@@ -296,6 +298,15 @@ def make_plan(population, scenes, *, afferent_types=None, trials: int = 1, recor
     -------
     Plan
     """
+    check_instance(population, "population", Population, "a Population (from sample_population or make_population)")
+    scenes = as_scenes(scenes)
+    for name, value in (("trials", trials), ("chunk_size", chunk_size), ("time_chunk", time_chunk)):
+        check_count(value, name)
+    named = (("afferent_types", () if afferent_types is None else afferent_types, ("SAI",)),
+             ("record", record, RECORD_CHOICES))
+    for name, value, example in named:
+        if isinstance(value, str) or not hasattr(value, "__iter__"):
+            raise TypeError(f"{name} must be a sequence of names, e.g. {example}, got {type(value).__name__}")
     requested = (tuple(AFFERENT_TYPES) if afferent_types is None
                  else tuple(normalize_type(t, "afferent_types") for t in afferent_types))
     for r in record:

@@ -55,6 +55,7 @@ def choose_setting(tolerance: float, fs: float) -> dict:
     True
     """
     tolerance = check_positive(tolerance, "tolerance", "pulses/s")
+    fs = check_positive(fs, "fs", "Hz")
     rows = [r for r in load_table() if abs(round(1.0 / (fs * r["dt_ms"] * 1e-3)) * r["dt_ms"] * 1e-3 * fs - 1.0) < 1e-9]
     ok = [r for r in rows if r["sf_err_mean"] <= tolerance]
     if not ok:

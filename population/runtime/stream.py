@@ -27,8 +27,8 @@ from ddmm.population.runtime.noise import noise_key, root_seed
 from ddmm.population.sampling import Population
 from ddmm.population.simulation import _grouped, block_pipeline
 from ddmm.population.stimuli.conditioning import Conditioner, Conditioning, noise_allowance
-from ddmm.population.stimuli.recordings import RECORDED
-from ddmm.population.stimuli.scenes import DEFAULT_FS, Contact, Sites
+from ddmm.population.stimuli.recordings import MAX_FORCE_N, RECORDED, check_force_bound
+from ddmm.population.stimuli.scenes import DEFAULT_FS, MAX_FS, Contact, Sites
 from ddmm.utils.deprecation import renamed_keyword
 from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 
@@ -95,6 +95,9 @@ class Encoder:
     model_fs : float, optional
         The model's sample rate with ``conditioning`` (default 1000 Hz, the
         rate `from_csv` gives); without it the model runs at ``fs``.
+    max_force_n : float
+        The largest force (N, magnitude) a pushed sample may carry at a site,
+        1 kN by default: a chunk beyond it is refused (a unit slip).
 
     Notes
     -----
@@ -114,10 +117,14 @@ class Encoder:
     @renamed_keyword("types", "afferent_types")
     def __init__(self, population, fs: float, *, dt: float = 1e-4, engine: str = "direct", method: str = "euler",
                  seed=None, no_shear: str = "smooth", contact: Contact | None = None, sites: Sites | None = None,
-                 afferent_types=None, conditioning: Conditioning | None = RECORDED, model_fs: float | None = None):
+                 afferent_types=None, conditioning: Conditioning | None = RECORDED, model_fs: float | None = None,
+                 max_force_n: float = MAX_FORCE_N):
         if not isinstance(population, Population):
             raise TypeError(f"population must be a Population, got {type(population).__name__}")
         self.fs = check_positive(fs, "fs", "Hz")
+        if self.fs > MAX_FS:
+            raise ValueError(f"fs = {self.fs:g} Hz is beyond any force sensor (at most {MAX_FS:g} Hz)")
+        self.max_force_n = check_positive(max_force_n, "max_force_n", "N")
         self.conditioning = conditioning
         self.model_fs = self._model_fs(conditioning, model_fs)
         self.substeps = substeps_for(self.model_fs, dt)
@@ -213,6 +220,7 @@ class Encoder:
                                  f"encoder's sites, got {forces.shape}")
         elif forces.ndim != 2 or forces.shape[1] != 3:
             raise ValueError(f"forces must have shape (n, 3) for (fx, fy, fz), got {forces.shape}")
+        check_force_bound(forces, self.max_force_n, "forces")
         allowance = 0.0 if self.conditioning is None else noise_allowance(self.conditioning)
         if forces.size and float(forces[..., 2].min()) < -allowance:
             raise ValueError(f"forces: the normal force fz must be >= {-allowance:g} N, got "
@@ -242,8 +250,9 @@ class Encoder:
         Raises
         ------
         ValueError
-            For non-finite values, a negative normal force, a wrong shape or
-            time going backwards; the encoder's state is left untouched.
+            For non-finite values, a negative normal force, a force beyond
+            ``max_force_n``, a wrong shape or time going backwards; the
+            encoder's state is left untouched.
         """
         forces, times = self._validate(forces, times)
         if self._conditioner is not None:

@@ -77,7 +77,7 @@ from ddmm.population.stimuli._conditioning_kernels import (
     sos_filter,
     track_band,
 )
-from ddmm.utils.validation import as_finite_array, check_positive
+from ddmm.utils.validation import as_finite_array, check_count, check_instance, check_positive
 
 __all__ = ["Conditioning", "Conditioner", "condition_forces", "noise_allowance", "CONDITIONING_MODES"]
 
@@ -238,7 +238,7 @@ class Conditioner:
             raise TypeError(f"conditioning must be a Conditioning, got {type(conditioning).__name__}")
         if conditioning.mode != "causal":
             raise ValueError("a Conditioner (a stream) is causal; mode='zero_phase' exists offline only")
-        self.settings, self.n_sites = conditioning, n_sites
+        self.settings, self.n_sites = conditioning, None if n_sites is None else check_count(n_sites, "n_sites")
         self.fs_in, self.fs_out = check_positive(fs_in, "fs_in", "Hz"), check_positive(fs_out, "fs_out", "Hz")
         cutoff = min(0.45 * self.fs_in, 0.45 * self.fs_out, conditioning.bandwidth_hz or math.inf)
         self._up = self.fs_out >= self.fs_in
@@ -426,6 +426,7 @@ def condition_forces(forces, fs_in: float, fs_out: float, conditioning: Conditio
     (True, True)
     """
     conditioning = Conditioning() if conditioning is None else conditioning
+    check_instance(conditioning, "conditioning", Conditioning, "a Conditioning or None")
     forces = as_finite_array(forces, "forces")
     n_sites = None if forces.ndim == 2 else forces.shape[1]
     if conditioning.mode == "causal":

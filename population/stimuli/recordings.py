@@ -20,15 +20,15 @@ from pathlib import Path
 import numpy as np
 
 from ddmm.population.stimuli._csv_header import match_columns, split_unit
-from ddmm.population.stimuli.file_options import GAPS, NEGATIVE_FZ, TIME_UNITS, UNITS
+from ddmm.population.stimuli.file_options import GAPS, MAX_FORCE_N, NEGATIVE_FZ, TIME_UNITS, UNITS
 from ddmm.population.stimuli.conditioning import Conditioning, condition_forces, noise_allowance
 from ddmm.population.stimuli.scenes import DEFAULT_FS, MAX_FS, Contact, Scene
 from ddmm.utils.notices import with_cli
 from ddmm.utils.resources import check_memory
-from ddmm.utils.validation import check_positive, parse_number, shown
+from ddmm.utils.validation import as_finite_array, check_path, check_positive, parse_number, shown
 
-__all__ = ["from_csv", "resample_unconditioned", "warn_band", "UNITS", "RECORDED", "RecordingBandWarning",
-           "NEGATIVE_FZ", "GAPS", "FA_II_MIN_FS"]
+__all__ = ["from_csv", "resample_unconditioned", "warn_band", "check_force_bound", "UNITS", "RECORDED",
+           "RecordingBandWarning", "NEGATIVE_FZ", "GAPS", "FA_II_MIN_FS", "MAX_FORCE_N"]
 
 #: The conditioning `from_csv` applies unless told otherwise.
 RECORDED = Conditioning()
@@ -78,6 +78,8 @@ def _read(path, wanted: dict) -> tuple:
 
 def _mapping(columns, recorded_fs) -> dict:
     mapping = {k: k for k in _FIELDS}
+    if columns is not None and not isinstance(columns, dict):
+        raise TypeError(f"columns must be a dict (our name -> the file's column) or None, got {type(columns).__name__}")
     for key, value in (columns or {}).items():
         if key not in mapping:
             raise ValueError(f"columns: unknown key {key!r}; allowed: {', '.join(_FIELDS)}")
@@ -133,7 +135,7 @@ def _negative(path, fz, forces, negative_fz, conditioning, fs_in):
 def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recorded_fs: float | None = None,
              time_scale: float | None = None, units: str | None = None, force_scale: float = 1.0, fz_sign: int = 1,
              negative_fz: str = "error", gaps: str = "error", conditioning: Conditioning | None = RECORDED,
-             name: str | None = None, contact: Contact | None = None) -> Scene:
+             name: str | None = None, contact: Contact | None = None, max_force_n: float = MAX_FORCE_N) -> Scene:
     """A scene from a recorded force file (a force plate, a load cell, a fingertip sensor).
 
     Parameters
@@ -174,6 +176,10 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
         Condition name (default: the file stem).
     contact : Contact, optional
         Contact geometry.
+    max_force_n : float
+        The largest force (N, the magnitude of F_X, F_Y, F_Z) the file may
+        carry, 1 kN by default (`MAX_FORCE_N`): beyond it the file is read in
+        the wrong unit.  Raise it for a rig that loads more.
 
     Raises
     ------
@@ -196,6 +202,7 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
     (1000.0, 1.97)
     >>> # ... 2 N less the contact threshold (30 mN), as for a sensor of the declared noise
     """
+    check_path(path)
     _check_options(fs, units, fz_sign, negative_fz, gaps, conditioning)
     mapping = _mapping(columns, recorded_fs)
     data, header, cells = _read(path, mapping)
@@ -215,6 +222,7 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
                          f"{MAX_FS:g} Hz): check its time column, --time-scale or --fs")
     scale = UNITS[units] * check_positive(force_scale, "force_scale")
     forces = np.column_stack([data["fx"] * scale, data["fy"] * scale, data["fz"] * scale * fz_sign])
+    check_force_bound(forces, max_force_n, f"scene file {str(path)!r}", fs_in)
     forces = _negative(path, forces[:, 2], forces, negative_fz, conditioning, fs_in)
     warn_band(Path(path).name, fs_in, stacklevel=3)
     n_out = forces.shape[0] * fs / fs_in
@@ -225,6 +233,36 @@ def from_csv(path, *, columns: dict | None = None, fs: float = DEFAULT_FS, recor
     else:
         out, _ = condition_forces(forces, fs_in, fs, conditioning)
     return Scene(out[:, 0], out[:, 1], out[:, 2], fs=fs, name=name or Path(path).stem, contact=contact)
+
+
+def check_force_bound(forces, max_force_n: float, where: str, fs: float | None = None) -> None:
+    """Refuse forces beyond ``max_force_n`` N at any site: a unit slip, not a touch.
+
+    ``forces`` has F_X, F_Y, F_Z in N on its last axis (samples first); the
+    magnitude of each site's force is compared.  ``where`` names the input
+    in the error, and ``fs`` (Hz) lets it give the time of the first
+    offending sample.
+
+    Examples
+    --------
+    >>> check_force_bound(np.array([[0.0, 0.5, 3.0]]), 1000.0, "plate.csv")
+    >>> check_force_bound(np.array([[0.0, 0.0, 3000.0]]), 1000.0, "plate.csv")
+    Traceback (most recent call last):
+    ...
+    ValueError: plate.csv: a force of 3000 N at sample 0, beyond max_force_n = 1000 N (--max-force): no hand contact comes near it; check the unit (mN read as N or kgf?), or raise the bound
+    """
+    bound = check_positive(max_force_n, "max_force_n", "N")
+    forces = np.asarray(forces, dtype=float)
+    if forces.size == 0:
+        return
+    magnitude = np.sqrt(np.einsum("...i,...i->...", forces, forces)).reshape(forces.shape[0], -1).max(axis=1)
+    beyond = np.flatnonzero(magnitude > bound)
+    if beyond.size:
+        k = int(beyond[0])
+        when = f"t = {k / fs:.6g} s" if fs else f"sample {k}"
+        raise ValueError(f"{where}: a force of {magnitude[k]:.6g} N at {when}, beyond max_force_n = {bound:g} N "
+                         "(--max-force): no hand contact comes near it; check the unit (mN read as N or kgf?), or "
+                         "raise the bound")
 
 
 def _resolve_units(path, cells: dict, units, time_scale) -> tuple:
@@ -295,6 +333,9 @@ def resample_unconditioned(forces, fs_in: float, fs: float) -> np.ndarray:
     >>> np.round(out[:, 2], 3).tolist()
     [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]
     """
+    forces = as_finite_array(forces, "forces", ndim=2)
+    check_positive(fs_in, "fs_in", "Hz")
+    check_positive(fs, "fs", "Hz")
     t = np.arange(forces.shape[0]) / fs_in
     grid = np.arange(int(math.floor(t[-1] * fs + 1e-9)) + 1) / fs
     if t.size < 3:

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ddmm.utils.resources import check_memory
-from ddmm.utils.validation import as_finite_array, check_positive, shown
+from ddmm.utils.validation import as_finite_array, check_nonnegative, check_positive, check_real, shown
 
 __all__ = [
     "DEFAULT_FS",
@@ -48,9 +48,7 @@ class Contact:
 
     def __post_init__(self):
         for name in ("x_mm", "y_mm"):
-            value = getattr(self, name)
-            if not np.isfinite(value):
-                raise ValueError(f"contact {name} must be finite, got {shown(value)}")
+            check_real(getattr(self, name), f"contact {name}", "mm")
         check_positive(self.radius_mm, "contact radius_mm", "mm")
         if self.radius_mm > MAX_RADIUS_MM:
             raise ValueError(f"contact radius_mm must be <= {MAX_RADIUS_MM:g} mm (a contact larger than a hand), "
@@ -84,7 +82,7 @@ class Sites:
         x = as_finite_array(self.x_mm, "sites x_mm", ndim=1)
         n = x.size
         if n == 0:
-            raise ValueError("sites: need at least one site, got 0")
+            raise ValueError("sites x_mm must hold at least one site, got 0")
         y = as_finite_array(self.y_mm, "sites y_mm", ndim=1)
         r = np.broadcast_to(as_finite_array(self.radius_mm, "sites radius_mm"), (n,)).copy()
         if y.size != n:
@@ -201,6 +199,10 @@ class Scene:
             raise ValueError(f"fs must be <= {MAX_FS:g} Hz (no force sensor samples faster), got {float(self.fs):g}")
         if self.contact is not None and not isinstance(self.contact, Contact):
             raise TypeError(f"contact must be a Contact or None, got {type(self.contact).__name__}")
+        if not isinstance(self.name, str):
+            raise TypeError(f"name must be a str (the condition label), got {type(self.name).__name__}")
+        if isinstance(self.stages, str) or not hasattr(self.stages, "__iter__"):
+            raise TypeError(f"stages must be a tuple of Stage, got {type(self.stages).__name__}")
         for n, a in zip(("fx", "fy", "fz"), arrays):
             a.setflags(write=False)
             object.__setattr__(self, n, a)
@@ -284,6 +286,19 @@ class Scene:
         return float(np.max(np.hypot(self.fx, self.fy)))
 
 
+def as_scenes(scenes, name: str = "scenes") -> list:
+    """``scenes`` (a Scene or a non-empty sequence of Scenes) as a list; TypeError naming ``name`` otherwise."""
+    listed = [scenes] if isinstance(scenes, Scene) else (
+        list(scenes) if hasattr(scenes, "__iter__") and not isinstance(scenes, str) else None)
+    if not listed or not all(isinstance(s, Scene) for s in listed):
+        if listed is None:
+            got = type(scenes).__name__
+        else:
+            got = f"a sequence of {', '.join(sorted({type(s).__name__ for s in listed}))}" if listed else "an empty sequence"
+        raise TypeError(f"{name} must be a Scene or a non-empty sequence of Scenes, got {got}")
+    return listed
+
+
 def _check_site_fz(forces, sites, fs) -> None:
     if np.any(forces[:, :, 2] < 0):
         k, j = np.argwhere(forces[:, :, 2] < 0)[0]
@@ -336,6 +351,11 @@ def birznieks(direction_deg: float | None = 90.0, *, normal_n: float = 4.0, angl
     >>> round(float(s.fy.max()), 3), s.duration
     (1.456, 0.5)
     """
+    if direction_deg is not None:
+        check_real(direction_deg, "direction_deg", "degrees")
+    check_nonnegative(normal_n, "normal_n", "N")
+    check_positive(ramp_s, "ramp_s", "s")
+    check_nonnegative(hold_s, "hold_s", "s")
     _check_delay(shear_delay_s, ramp_s)
     if not (isinstance(angle_deg, (int, float)) and 0.0 <= angle_deg <= MAX_INCLINATION_DEG):
         raise ValueError(f"angle_deg must be in [0, {MAX_INCLINATION_DEG:g}] degrees from the normal, got {shown(angle_deg)}")
@@ -381,6 +401,10 @@ def press_push_lift(theta_r: float = 90.0, *, press_n: float = 3.0, push_n: floa
     >>> s.duration, round(float(s.fz.max()), 1)
     (30.0, 6.0)
     """
+    check_real(theta_r, "theta_r", "degrees")
+    for name, value in (("press_n", press_n), ("push_n", push_n), ("shear_n", shear_n)):
+        if value is not None:
+            check_nonnegative(value, name, "N")
     shear_n = push_n * np.tan(np.deg2rad(20.0)) if shear_n is None else shear_n
     lift_s = ramp_s if lift_ramp_s is None else lift_ramp_s
     for name, value, top in (("ramp_s", ramp_s, 10.0), ("lift_ramp_s", lift_s, 5.0)):
@@ -419,6 +443,11 @@ def rotating_shear(*, normal_n: float = 4.0, shear_n: float = 1.456, period_s: f
     >>> round(s.duration, 3)
     1.25
     """
+    check_nonnegative(normal_n, "normal_n", "N")
+    check_real(shear_n, "shear_n", "N")
+    check_real(start_deg, "start_deg", "degrees")
+    for name, value in (("period_s", period_s), ("turns", turns), ("ramp_s", ramp_s)):
+        check_positive(value, name)
     rotate_s = period_s * turns
     t = _samples(2 * ramp_s + rotate_s, fs)
     knots = [0.0, ramp_s, ramp_s + rotate_s, 2 * ramp_s + rotate_s]

@@ -52,10 +52,12 @@ SA-II.  A control scene (``slip=False``) ramps to
 
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 
 from ddmm.population.stimuli.scenes import DEFAULT_FS, Scene, Sites, Stage, taxel_radius
-from ddmm.utils.validation import check_positive, shown
+from ddmm.utils.validation import as_finite_array, check_nonnegative, check_positive, check_real, shown
 
 __all__ = ["contact_grid", "torsion", "incipient_slip", "grasp", "digit_tip_sites"]
 
@@ -80,9 +82,17 @@ def contact_grid(radius_mm: float, pitch_mm: float, *, center_mm=(0.0, 0.0), reg
     if not inside.any():
         raise ValueError(f"pitch_mm={pitch_mm!r} is too coarse for radius_mm={radius_mm!r}: no cell centre inside")
     dx, dy = dx[inside], dy[inside]
-    cx, cy = (float(v) for v in center_mm)
+    cx, cy = _center(center_mm)
     ids = [f"c{i:03d}" for i in range(dx.size)]
     return Sites(cx + dx, cy + dy, taxel_radius(pitch), region=[region] * dx.size, site_id=ids), dx, dy
+
+
+def _center(center_mm) -> tuple:
+    """``center_mm`` as an (x, y) pair of finite floats, mm."""
+    center = as_finite_array(center_mm, "center_mm")
+    if center.shape != (2,):
+        raise ValueError(f"center_mm must be an (x, y) pair in mm, got shape {center.shape}")
+    return float(center[0]), float(center[1])
 
 
 def _envelope(t, knots, values):
@@ -118,7 +128,8 @@ def torsion(torque_mnm: float = 5.0, normal_n: float = 3.0, radius_mm: float = 6
     """
     if direction not in (1, -1):
         raise ValueError(f"direction must be +1 or -1, got {shown(direction)}")
-    if not np.isfinite(torque_mnm) or torque_mnm < 0:
+    real = isinstance(torque_mnm, numbers.Real) and not isinstance(torque_mnm, bool)
+    if not real or not np.isfinite(torque_mnm) or torque_mnm < 0:
         raise ValueError(f"torque_mnm must be finite and >= 0 mNm, got {shown(torque_mnm)}")
     check_positive(normal_n, "normal_n", "N")
     sites, dx, dy = contact_grid(radius_mm, pitch_mm, center_mm=center_mm, region=region)
@@ -221,10 +232,23 @@ def digit_tip_sites(digits=("D1", "D2", "D3", "D4", "D5")) -> Sites:
     from ddmm.population.anatomy.hand_map import get_region
     from ddmm.population.anatomy.receptive_fields import REFERENCE_AREA_MM2
 
-    tips = [get_region(f"{d}d") for d in digits]
+    tips = [get_region(f"{d}d") for d in _digits(digits)]
     radius = float(np.sqrt(REFERENCE_AREA_MM2 / np.pi))
     return Sites([tip.center_mm[0] for tip in tips], [tip.center_mm[1] for tip in tips], radius,
                  region=[tip.name for tip in tips], site_id=[tip.name for tip in tips])
+
+
+def _digits(digits) -> list:
+    """``digits`` as a list of distinct digit names (``"D1"`` .. ``"D5"``); errors name ``digits``."""
+    allowed = ("D1", "D2", "D3", "D4", "D5")
+    if isinstance(digits, str) or not hasattr(digits, "__iter__"):
+        raise TypeError(f"digits must be a sequence of digit names ({', '.join(allowed)}), got {type(digits).__name__}")
+    digits = list(digits)
+    bad = [d for d in digits if not isinstance(d, str) or d not in allowed]
+    if bad or not digits or len(set(digits)) != len(digits):
+        got = f"{bad[0]!r}" if bad else ("none" if not digits else "a repeated digit")
+        raise ValueError(f"digits must name one or more distinct digits of {', '.join(allowed)}, got {got}")
+    return digits
 
 
 def grasp(digits=("D1", "D2"), *, load_n: float = 2.0, mu: float = 1.0, safety: float = 1.4,
@@ -242,9 +266,14 @@ def grasp(digits=("D1", "D2"), *, load_n: float = 2.0, mu: float = 1.0, safety: 
     from ddmm.population.anatomy.hand_map import get_region
 
     sites = digit_tip_sites(digits)
-    tips = [get_region(f"{d}d") for d in digits]
+    tips = [get_region(f"{d}d") for d in _digits(digits)]
     for value, label in ((load_n, "load_n"), (mu, "mu"), (safety, "safety"), (preload_n, "preload_n")):
         check_positive(value, label, "N or 1")
+    for label, value in (("preload_s", preload_s), ("loading_s", loading_s), ("hold_s", hold_s),
+                         ("replace_s", replace_s), ("release_s", release_s)):
+        check_nonnegative(value, label, "s")
+    check_real(load_direction_deg, "load_direction_deg", "degrees")
+    check_positive(fs, "fs", "Hz")
     n = len(tips)
     grip = max(safety * (load_n / n) / mu, preload_n)
     knots = np.cumsum([0.0, preload_s, loading_s, hold_s, replace_s, release_s])

@@ -53,6 +53,16 @@ def test_linear_rules_take_their_options(run, tmp_path):
     ("centre,0,0,4,,20,80,200,300,20\n", ["--rule", "biomimetic", "--rate-hz", "50"],
      "--rate-hz applies to the linear-amplitude rule(s), not --rule biomimetic"),
     ("centre,0,0,4,,20,80,200,300,20\n", ["--rule", "nope"], "invalid choice: 'nope'"),
+    ("centre,0,0,4,,20,80,200,300,20\n", ["--tau", "1e15"], "--tau must be a finite number in (0, 1000] ms, got 1e+15"),
+    ("centre,0,0,4,,20,80,200,300,20\n", ["--rate-sat", "1e9"], "--rate-sat must be a finite number in (0, 1000] Hz"),
+    ("centre,0,0,4,,20,80,200,300,20\n", ["--rule", "linear-amplitude", "--rate-hz", "1e-3"],
+     "--rate-hz must be a finite number in [1, 2000] Hz, got 0.001"),
+    ("centre,0,0,4,,20,80,200,300,20\n", ["--rule", "linear-frequency", "--force-sat", "1e15"],
+     "--force-sat must be a finite number in (0.05, 500] N, got 1e+15"),
+    ('"centre\n  forged: 999 pulses",0,0,4,,20,80,200,300,20\n', [], "holds the unprintable character U+000A"),
+    ("far,1000,1000,5,,20,80,200,300,20\nnowhere,,,,D9,20,80,200,300,20\n", [],
+     ("no electrode of the table reaches an afferent of population 'custom' or a force site: 'far' (disc (1000, 1000) "
+      "mm r 5), 'nowhere' (region 'D9');")),
 ])
 def test_bad_tables_and_options_are_one_line_with_exit_2(run, tmp_path, capsys, body, argv, message):
     table = tmp_path / "e.csv"
@@ -62,6 +72,36 @@ def test_bad_tables_and_options_are_one_line_with_exit_2(run, tmp_path, capsys, 
         code = main(["stimulate", str(run), "--electrodes", str(table), "--out", str(out), *argv])
     except SystemExit as exc:  # argparse's own usage errors
         code = exc.code
+    captured = capsys.readouterr()
+    assert code == 2 and message in captured.err and len(captured.err.strip().splitlines()) == 1
+    assert not out.exists() and "pulses" not in captured.out
+
+
+@pytest.mark.parametrize("header, message", [
+    (HEADER.strip() + ",amplitude_max_ua", "line 1: field 'amplitude_max_ua' is given twice (column 7"),
+    (HEADER.strip() + ",ID", "line 1: field 'id' is given twice (column 1 'id' and column 11 'ID'; names ignore case)"),
+])
+def test_a_header_naming_a_field_twice_is_one_line_with_exit_2(run, tmp_path, capsys, header, message):
+    table = tmp_path / "e.csv"
+    table.write_text(header + "\ncentre,0,0,4,,20,80,200,300,20,90\n")
+    code = main(["stimulate", str(run), "--electrodes", str(table), "--out", str(tmp_path / "p.nc")])
     err = capsys.readouterr().err
-    assert code == 2 and message in err and len(err.strip().splitlines()) == 1
-    assert not out.exists()
+    assert code == 2 and f"ddmm: error: electrode table '{table}', {message}" in err and err.count("\n") == 1
+
+
+def test_a_megabyte_id_is_one_line_naming_the_file(run, tmp_path, capsys):
+    table = tmp_path / "e.csv"
+    table.write_text(HEADER + "E" * 1_000_000 + ",0,0,4,,20,80,200,300,20\n")
+    code = main(["stimulate", str(run), "--electrodes", str(table), "--out", str(tmp_path / "p.nc")])
+    err = capsys.readouterr().err
+    assert code == 2 and err == (f"ddmm: error: electrode table '{table}', line 2: 1,000,024 characters, more than "
+                                 "the 4,096 a table's line may hold\n")
+
+
+def test_a_field_without_afferents_on_the_contact_still_pulses(run, tmp_path, capsys):
+    """The run's two afferents have no region; a D2 field takes the contact's force (its centre lies in D2d)."""
+    table = tmp_path / "e.csv"
+    table.write_text(HEADER + "index,,,,D2,20,80,200,300,20\n")
+    argv = ["stimulate", str(run), "--electrodes", str(table), "--out", str(tmp_path / "p.nc"), "--no-figures"]
+    assert main(argv + ["--rule", "linear-amplitude"]) == 0
+    assert load_pulses(tmp_path / "p.nc").sizes["pulse"] > 0 and "ddmm: warning" not in capsys.readouterr().err

@@ -126,6 +126,19 @@ def test_table4_errors_are_one_line(capsys, argv, match):
     assert code == 2 and match in err and err.count("\n") == 1, err
 
 
+def test_table4_refuses_a_recording_that_never_reaches_contact(capsys, tmp_path):
+    """A light touch that stays at 0.04 N would give a table of zeros: SF is the mean rate in contact."""
+    t = np.arange(3000) / 1000.0
+    path = tmp_path / "light.csv"
+    np.savetxt(path, np.column_stack([t, 0 * t, 0 * t, 0.04 + 0 * t]), delimiter=",", header="time,fx,fy,fz",
+               comments="")
+    code = main(["reproduce", "table4", "--scene", str(path), "--engine", "direct"])
+    captured = capsys.readouterr()
+    errors = [line for line in captured.err.splitlines() if line.startswith("ddmm: error: ")]
+    assert code == 2 and not captured.out and len(errors) == 1, captured
+    assert f"recording '{path}' never reaches contact" in errors[0] and "contact threshold 0.05 N" in errors[0]
+
+
 @pytest.mark.slow
 def test_the_fit_reproduces_the_committed_ra_i_setting():
     """``ddmm calibrate --target paper`` for RA-I (its chosen reading and SF definition) gives the committed values."""

@@ -8,8 +8,9 @@ from hypothesis import strategies as st
 from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.population import Contact, Scene, Sites, sample_population, simulate
 from ddmm.population.runtime import Encoder
-from ddmm.population.neurostim import (Biomimetic, Electrode, ElectrodeTable, PulseKernel, StimulationEncoder,
-                                         check_pulses, load_pulses, read_electrodes, save_pulses, stimulation_pulses)
+from ddmm.population.neurostim import (Biomimetic, Electrode, ElectrodeTable, LinearAmplitude, LinearFrequency,
+                                         PulseKernel, StimulationEncoder, check_pulses, load_pulses, read_electrodes,
+                                         save_pulses, stimulation_pulses)
 from ddmm.population.neurostim.pulses import disc_overlap
 
 RULES = ("biomimetic", "linear-amplitude", "linear-frequency")
@@ -70,6 +71,61 @@ def test_tables_read_from_csv_and_toml_and_errors_name_file_line_and_field(tmp_p
         bad.write_text(body)
         with pytest.raises(ValueError, match=f"electrode table '{bad}'.*{message}"):
             read_electrodes(bad)
+
+
+HEADER = "id,x_mm,y_mm,radius_mm,region,amplitude_min_ua,amplitude_max_ua,phase_width_us,max_rate_hz,charge_limit_nc"
+ROW = "E1,0,0,4,,20,80,200,300,20"
+TOML = ('[[electrode]]\nregion = "D1d"\namplitude_min_ua = 20\namplitude_max_ua = 80\nphase_width_us = 200\n'
+        'max_rate_hz = 300\ncharge_limit_nc = 20\n')
+
+
+@pytest.mark.parametrize("name, body, message", [
+    ("e.csv", f"{HEADER},amplitude_max_ua\n{ROW},90\n",
+     "line 1: field 'amplitude_max_ua' is given twice \\(column 7 'amplitude_max_ua' and column 11"),
+    ("e.csv", f"{HEADER},ID\n{ROW},E2\n", "line 1: field 'id' is given twice \\(column 1 'id' and column 11 'ID'"),
+    ("e.toml", TOML + 'id = "T1"\nID = "T2"\n', "electrode 1: field 'id' is given twice \\('id' and 'ID'"),
+])
+def test_a_field_given_twice_in_any_case_is_refused_not_merged(tmp_path, name, body, message):
+    path = tmp_path / name
+    path.write_text(body)
+    with pytest.raises(ValueError, match=f"electrode table '{path}', {message}"):
+        read_electrodes(path)
+
+
+@pytest.mark.parametrize("name, body, message", [
+    ("e.csv", f'{HEADER}\n"E1\nE2: 999 pulses",0,0,4,,20,80,200,300,20\n', r"id 'E1\\nE2: 999 pulses' holds .* U\+000A"),
+    ("e.csv", f"{HEADER}\nE1\x1b[2K,0,0,4,,20,80,200,300,20\n", r"U\+001B"),
+    ("e.csv", f"{HEADER}\nE1\u202e,0,0,4,,20,80,200,300,20\n", r"U\+202E"),
+    ("e.csv", f"{HEADER}\n{'E' * 65},0,0,4,,20,80,200,300,20\n", "id must be at most 64 characters, got 65"),
+    ("e.csv", f'{HEADER}\nE1,,,,"D2\nE9",20,80,200,300,20\n', r"electrode 'E1': region 'D2\\nE9' holds .* U\+000A"),
+    ("e.toml", TOML + 'id = "T1\\nT2"\n', r"electrode 1: electrode id 'T1\\nT2' holds .* U\+000A"),
+    ("e.toml", TOML.replace("D1d", "D1\\u2028d") + 'id = "T1"\n', r"region 'D1\\u2028d' holds .* U\+2028"),
+])
+def test_ids_and_regions_that_cannot_print_on_one_line_are_refused(tmp_path, name, body, message):
+    path = tmp_path / name
+    path.write_text(body)
+    with pytest.raises(ValueError, match=f"electrode table '{path}', .*{message}"):
+        read_electrodes(path)
+
+
+def test_a_64_character_id_prints_and_is_taken():
+    assert _electrode("E" * 64).id == "E" * 64
+    with pytest.raises(ValueError, match=r"electrode id must be at most 64 characters, got 1,000,000 \('EEE"):
+        _electrode("E" * 1_000_000)
+
+
+def test_oversized_tables_are_refused_naming_the_file_before_they_are_read(tmp_path):
+    cases = {"id.csv": f"{HEADER}\n{'E' * 1_000_000},0,0,4,,20,80,200,300,20\n",  # a 1 MB id
+             "open.csv": f'{HEADER}\n"E1,' + ("x" * 4000 + "\n") * 40}  # a quote left open over 160 kB
+    for name, body in cases.items():
+        (tmp_path / name).write_text(body)
+    with open(tmp_path / "sparse.csv", "wb") as f:
+        f.truncate(1 << 30)  # 1 GiB of holes: nothing to read, everything to refuse
+    for name, message in (("id.csv", ", line 2: 1,000,024 characters, more than the 4,096 a table's line may hold"),
+                          ("open.csv", r", line 2: not valid CSV \(field larger than field limit \(131072\): is a quote"),
+                          ("sparse.csv", ": larger than the 1,048,576 bytes an electrode table may hold")):
+        with pytest.raises(ValueError, match=f"electrode table '{tmp_path / name}'{message}"):
+            read_electrodes(tmp_path / name)
 
 
 def test_disc_overlap_is_the_area_fraction():
@@ -154,7 +210,7 @@ def test_the_last_check_drops_a_pulse_closer_than_the_rate_limit_allows():
 
 @pytest.mark.parametrize("rule", RULES)
 def test_rate_and_amplitude_rise_with_force_and_a_field_without_contact_is_silent(presses, rule):
-    table = [_electrode("centre"), _electrode("far", x_mm=0.0, y_mm=-30.0, radius_mm=2.0)]
+    table = [_electrode("centre"), _electrode("far", x_mm=0.0, y_mm=-9.0, radius_mm=2.0)]  # afferents, no contact
     pulses = stimulation_pulses(presses, table, rule)
     assert check_pulses(pulses) == [] and not np.any(pulses.pulse_electrode.values == 1)
     hold = (pulses.pulse_electrode == 0) & (pulses.pulse_time > 0.4) & (pulses.pulse_time < 1.2)
@@ -166,6 +222,48 @@ def test_rate_and_amplitude_rise_with_force_and_a_field_without_contact_is_silen
     assert rates[0] > 0 and amps[0] > 0
     assert np.all(np.diff(rates) > 0) or rule == "linear-amplitude"
     assert np.all(np.diff(amps) > 0) or rule == "linear-frequency"
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda: Biomimetic(tau_s=1e12), r"biomimetic: tau_s must be a finite number in \(0, 1\] s, got 1e\+12"),
+    (lambda: Biomimetic(active_window_s=5.0), r"active_window_s must be a finite number in \(0, 1\] s, got 5"),
+    (lambda: Biomimetic(rate_sat_hz=1e9), r"rate_sat_hz must be a finite number in \(0, 1000\] spikes/s, got 1e\+09"),
+    (lambda: Biomimetic(weights=tuple((t, 0.0) for t in ("SAI", "RAI", "RAII", "SAII"))), "not all 0"),
+    (lambda: LinearAmplitude(rate_hz=0.001), r"linear-amplitude: rate_hz must be a finite number in \[1, 2000\] Hz"),
+    (lambda: LinearAmplitude(force_sat_n=0.05), r"force_sat_n must be a finite number in \(0.05, 500\] N, got 0.05"),
+    (lambda: LinearFrequency(force_sat_n=1e15), r"force_sat_n must be a finite number in \(0.05, 500\] N, got 1e\+15"),
+])
+def test_rule_settings_outside_their_physical_range_are_refused_with_it(make, message):
+    with pytest.raises(ValueError, match=message):
+        make()
+
+
+def test_the_ends_of_each_range_are_taken():
+    Biomimetic(tau_s=1.0, active_window_s=1.0, rate_sat_hz=1000.0, active_sat=1.0)
+    LinearAmplitude(rate_hz=1.0, force_sat_n=500.0), LinearAmplitude(rate_hz=2000.0, force_sat_n=0.051)
+
+
+@pytest.mark.parametrize("fields, named", [
+    ([{"x_mm": 1000.0, "y_mm": 1000.0, "radius_mm": 5.0}], r"'E0' \(disc \(1000, 1000\) mm r 5\);"),
+    ([{"region": "D9"}, {"x_mm": 0.0, "y_mm": -30.0, "radius_mm": 2.0}],
+     r"'E0' \(region 'D9'\), 'E1' \(disc \(0, -30\) mm r 2\);"),
+])
+def test_a_table_no_field_of_which_reaches_an_afferent_or_a_site_is_refused(presses, fields, named):
+    table = [_electrode(f"E{i}", **f) for i, f in enumerate(fields)]
+    with pytest.raises(ValueError, match=f"no electrode of the table reaches an afferent of population "
+                                         f"'fingertip' or a force site: {named} .* so no pulse could start"):
+        stimulation_pulses(presses, table)
+    enc = Encoder(sample_population("fingertip", rng=0), 1000.0, seed=2, conditioning=None,
+                  contact=Contact(0.0, 0.0, 5.0))
+    with pytest.raises(ValueError, match="no electrode of the table reaches an afferent"):
+        StimulationEncoder(enc, table)
+
+
+def test_one_field_off_the_skin_beside_others_warns_and_reports_no_pulse(presses):
+    table = [_electrode("centre"), _electrode("off", x_mm=1000.0, y_mm=1000.0, radius_mm=5.0)]
+    with pytest.warns(UserWarning, match=r"electrode\(s\) 'off' \(disc \(1000, 1000\) mm r 5\) reach no afferent"):
+        pulses = stimulation_pulses(presses, table, "linear-frequency")
+    assert not np.any(pulses.pulse_electrode.values == 1) and np.any(pulses.pulse_electrode.values == 0)
 
 
 @settings(max_examples=6, deadline=None)

@@ -95,7 +95,7 @@ def test_hdf5_links_are_refused(tmp_path):
 
 @pytest.mark.parametrize("call, text", [
     (lambda: __import__("ddmm.population", fromlist=["birznieks"]).birznieks(90.0, hold_s=np.float64(-1.0)),
-     "got -0.75"),
+     "hold_s must be a finite number >= 0 s, got -1.0"),
     (lambda: __import__("ddmm.population", fromlist=["birznieks"]).birznieks(90.0, angle_deg=np.float64(95.0)),
      "got 95.0"),
     (lambda: __import__("ddmm.models.neuron", fromlist=["NeuronParams"]).NeuronParams(b=np.float64(0.5)),
