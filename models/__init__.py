@@ -4,7 +4,8 @@ Modules, in the order a force becomes spikes:
 
 - `nap`: neural attenuation profiles (Table I) and their boundary radius;
 - `attenuation`: the attenuation factor AF of the shear direction (eqs 9-17);
-- `afferent_types`: the type codes, their display labels and accepted spellings;
+- `afferent_types`: the registry of afferent types (`AfferentType`): codes, labels, spellings
+  and the mechanisms of each type's drive;
 - `currents`: type-specific filtering of the attenuated force into currents, with
   its parameters (`current_params`), filters (`current_filters`) and keyed
   per-unit and per-trial draws (`variability`);

@@ -19,7 +19,7 @@ from functools import lru_cache
 import numpy as np
 
 from ddmm.models._stage_kernels import stage_kernel
-from ddmm.models.afferent_types import AFFERENT_TYPES
+from ddmm.models.afferent_types import AFFERENT_TYPES, afferent_type_info
 from ddmm.models.current_params import CurrentParams, TypeCurrentParams
 from ddmm.utils.cache import cache_root
 from ddmm.utils.deprecation import renamed_keyword, warn_renamed
@@ -28,16 +28,18 @@ from ddmm.utils.validation import as_finite_array, check_instance, check_positiv
 __all__ = ["RAII_FS_FACTOR", "FilterState", "check_fs", "filter_force", "initial_filter_state", "lowpass_sos",
            "type_filter_constants"]
 
-#: A scene must be sampled at least this many times faster than RA-II's cut-off.
-RAII_FS_FACTOR = 2.5
+#: A scene must be sampled at least this many times faster than RA-II's cut-off
+#: (its `ddmm.models.afferent_types.AfferentType.fs_per_cutoff`).
+RAII_FS_FACTOR = afferent_type_info("RAII").fs_per_cutoff
 
 
 @renamed_keyword("types", "afferent_types")
 def check_fs(fs: float, params: CurrentParams, afferent_types=AFFERENT_TYPES) -> None:
     """Refuse a sample rate too slow for a type's filter band.
 
-    RA-II's stage needs ``fs >= 2.5 * cutoff`` (its band must sit well below
-    the Nyquist frequency); every filter needs its cut-off below ``fs / 2``.
+    A type with `AfferentType.fs_per_cutoff` needs ``fs >= fs_per_cutoff * cutoff``
+    (RA-II's 2.5: its band must sit well below the Nyquist frequency); every
+    filter needs its cut-off below ``fs / 2``.
 
     Raises
     ------
@@ -48,8 +50,9 @@ def check_fs(fs: float, params: CurrentParams, afferent_types=AFFERENT_TYPES) ->
         stage = params.for_type(kind)
         if stage.cutoff_hz is None:
             continue
-        if kind == "RAII":
-            too_slow, need = fs < RAII_FS_FACTOR * stage.cutoff_hz, f"at >= {RAII_FS_FACTOR * stage.cutoff_hz:g} Hz"
+        factor = afferent_type_info(kind).fs_per_cutoff
+        if factor is not None:
+            too_slow, need = fs < factor * stage.cutoff_hz, f"at >= {factor * stage.cutoff_hz:g} Hz"
         else:  # a cut-off at or above Nyquist is no filter
             too_slow, need = stage.cutoff_hz >= fs / 2.0, f"faster than {2.0 * stage.cutoff_hz:g} Hz"
         if too_slow or stage.cutoff_hz >= fs / 2.0:

@@ -14,14 +14,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models.afferent_types import normalize_type
+from ddmm.models.afferent_types import AFFERENT_TYPES, afferent_type_info, normalize_type
 from ddmm.utils.deprecation import warn_renamed
 from ddmm.utils.validation import check_positive, shown
 
 __all__ = ["DERIVATIVE_ORDER", "CurrentParams", "TypeCurrentParams"]
 
-#: Derivative order of each type's drive: force, velocity, acceleration, stretch.
-DERIVATIVE_ORDER = {"SAI": 0, "RAI": 1, "RAII": 2, "SAII": 0}
+#: Derivative order of each type's drive: force, velocity, acceleration, stretch
+#: (`ddmm.models.afferent_types.AfferentType.derivative_order`).
+DERIVATIVE_ORDER = {code: afferent_type_info(code).derivative_order for code in AFFERENT_TYPES}
 
 
 def _optional_positive(obj, names, unit):
@@ -282,21 +283,25 @@ class CurrentParams:
         return float(self._own("excite_cv", normalize_type(afferent_type)))
 
     def saturation(self, afferent_type: str) -> float | None:
-        """The log-compression scale of ``afferent_type`` in mV/ms (None: linear; SA-II has none)."""
-        if afferent_type == "SAII":
+        """The log-compression scale of ``afferent_type`` in mV/ms (None: linear, as for a type without
+        `AfferentType.log_compression`, SA-II)."""
+        kind = afferent_type_info(afferent_type)
+        if not kind.log_compression:
             return None
-        own = self._own("i_sat", afferent_type)
+        own = self._own("i_sat", kind.code)
         return self.i_sat if own is None else own
 
     def for_type(self, afferent_type: str) -> TypeCurrentParams:
         """The current parameters of one type, resolved: filter, derivative order, transducer."""
-        afferent_type = normalize_type(afferent_type)
+        kind = afferent_type_info(afferent_type)
+        afferent_type = kind.code
         cutoff = self._own("cutoff", afferent_type, "_hz")
-        if afferent_type in ("RAI", "RAII"):
+        if kind.shared_cutoff:
             cutoff = cutoff or self.cutoff_hz  # the paper's shared low-pass before the derivatives
-        order = self.order_raii if afferent_type == "RAII" and self.order_raii is not None else self.filter_order
+        order = self._own("order", afferent_type)  # the type's own order (``order_raii``), if it has one
+        order = self.filter_order if order is None else order
         tau_adapt = self._own("tau_adapt", afferent_type, "_s", self.tau_adapt_sai_s)
-        return TypeCurrentParams(afferent_type, DERIVATIVE_ORDER[afferent_type], cutoff, order,
+        return TypeCurrentParams(afferent_type, kind.derivative_order, cutoff, order,
                             self._own("adapt", afferent_type, default=0.0), tau_adapt, self.gain(afferent_type),
                             self.saturation(afferent_type), self._own("i_max", afferent_type),
                             self._own("bias", afferent_type, default=0.0), self._own("tau", afferent_type, "_s"),
@@ -393,8 +398,9 @@ class TypeCurrentParams:
 
     @property
     def signed(self) -> bool:
-        """Whether the drive keeps its sign (SA-II's stretch) instead of being rectified."""
-        return self.afferent_type == "SAII"
+        """Whether the drive keeps its sign instead of being rectified: a stretch drive's
+        (`ddmm.models.afferent_types.AfferentType.stretch_drive`, SA-II's)."""
+        return afferent_type_info(self.afferent_type).stretch_drive
 
 
 def __getattr__(name):

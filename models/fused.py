@@ -102,6 +102,7 @@ from ddmm.models._stage_kernels import (
     transduce_columns,
     transduce_inplace,
 )
+from ddmm.models.afferent_types import type_mask
 from ddmm.models.attenuation import UNTUNED
 from ddmm.models.currents import excitability, initial_phase, tonic_current, type_filter_constants, unit_thresholds
 from ddmm.models.engines import NeuronState, check_integration, check_stability, get_engine, run_checked, substeps_for
@@ -417,10 +418,10 @@ class FusedPipeline:
 
     def initial_neuron(self, key, b, d, c):
         """Neuron state (v, u) before the first sample: at rest, or with ``phase_saii`` and a stream ``key``
-        each SA-II at its own phase (`ddmm.models.currents.initial_phase`): ``v = c``,
-        ``u = u_rest + phase_saii U d``."""
+        each afferent of a `AfferentType.phase_spread` type (SA-II) at its own phase
+        (`ddmm.models.currents.initial_phase`): ``v = c``, ``u = u_rest + phase_saii U d``."""
         v, u = (np.array(x, dtype=float) for x in resting_state(b))
-        tonic = self.afferent_type == "SAII"
+        tonic = type_mask(self.afferent_type, "phase_spread")
         if self.phase_saii > 0.0 and key is not None and tonic.any():
             cols = np.flatnonzero(tonic)
             v[cols] = np.asarray(c, dtype=float)[cols] if np.ndim(c) else c

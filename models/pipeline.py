@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models.afferent_types import AFFERENT_TYPES
+from ddmm.models.afferent_types import AFFERENT_TYPES, afferent_type_codes, type_mask
 from ddmm.models.attenuation import (
     F_TH,
     attenuated_force,
@@ -89,7 +89,7 @@ def compute_currents(
         )
     af = attenuation_factor(fx, fy, theta, profile, k, f_th=f_th, no_shear=no_shear)
     drive = attenuated_force(fz, af)
-    for kind in ("SAI", "RAI", "RAII"):  # the presets' shear-magnitude term (0 by default: F_A as it is)
+    for kind in afferent_type_codes(lambda t: not t.stretch_drive):  # F_A's depth and the presets' shear term
         cols = np.flatnonzero(types == kind)
         stage = current_params.for_type(kind)
         if cols.size and stage.depth != 1.0:
@@ -97,8 +97,8 @@ def compute_currents(
         if cols.size and stage.shear != 0.0:
             raw = profile_factor(fx, fy, theta[cols], profile, np.broadcast_to(k, theta.shape)[cols])
             drive[:, cols] = shear_drive(drive[:, cols], fx, fy, raw, stage.shear, stage.opponent_shear)
-    stretch = np.flatnonzero(types == "SAII")
-    if stretch.size:  # SA-II: the attenuated shear (skin stretch), not the normal force
+    stretch = np.flatnonzero(type_mask(types, "stretch_drive"))
+    if stretch.size:  # a stretch drive (SA-II's): the attenuated shear (skin stretch), not the normal force
         raw = profile_factor(fx, fy, theta[stretch], profile, np.broadcast_to(k, theta.shape)[stretch])
         drive[:, stretch] = stretch_drive(fx, fy, raw, current_params.opponent_saii, fz, current_params.normal_saii)
     current = np.empty_like(drive)

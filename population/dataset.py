@@ -37,7 +37,7 @@ import numba as nb
 import numpy as np
 import xarray as xr
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, type_label
+from ddmm.models.afferent_types import AFFERENT_TYPES, afferent_type_codes, type_label
 from ddmm.models.attenuation import F_TH
 from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.models.neuron import NEURON_PARAMS, V_PEAK
@@ -73,7 +73,7 @@ def model_attrs(population, config) -> dict:
         **{f"current_{f.name}": "none" if getattr(cp, f.name) is None else getattr(cp, f.name)
            for f in dataclasses.fields(cp)},
         **{f"current_i_sat_{t.lower()}": "none" if cp.saturation(t) is None else cp.saturation(t)
-           for t in ("SAI", "RAI", "RAII")},
+           for t in afferent_type_codes("log_compression")},
         "noise_model": "white Gaussian current, (noise_sigma + noise_cv |I|)/sqrt(h) per sample of h ms",
         "rf_support": RF_SUPPORT,
         "receptive_field": population.receptive_field,

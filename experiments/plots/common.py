@@ -9,14 +9,14 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, PAPER_TYPES, type_label
+from ddmm.models.afferent_types import AFFERENT_TYPES, PAPER_TYPES, afferent_type_info, type_label
 
 __all__ = ["TYPE_COLOURS", "plot_response", "plot_sf_vs_theta",
            "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces",
            "plot_dsi_histograms", "plot_preferred_rose", "plot_neurometric", "plot_pareto"]
 
-#: The colour of each afferent type in every figure.
-TYPE_COLOURS = {"SAI": "tab:blue", "RAI": "tab:orange", "RAII": "tab:green", "SAII": "tab:purple"}
+#: The colour of each afferent type in every figure (`ddmm.models.afferent_types.AfferentType.colour`).
+TYPE_COLOURS = {code: afferent_type_info(code).colour for code in AFFERENT_TYPES}
 
 
 def _present(types) -> list:

@@ -33,7 +33,7 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from ddmm.models.afferent_types import AFFERENT_TYPES
+from ddmm.models.afferent_types import AFFERENT_TYPES, afferent_type_codes
 from ddmm.models.metrics import direction_index
 from ddmm.population.stimuli.scenes import birznieks
 from ddmm.utils.validation import check_dataset, check_real
@@ -48,8 +48,9 @@ TUNING_DIRECTIONS = {"radial": 0.0, "distal": 90.0, "ulnar": 180.0, "proximal": 
 #: typically held for minutes, enough for 5 x 5 stimuli of 0.5 s plus rests).
 DEFAULT_TRIALS = 5
 _PHASES = ("loading", "plateau")
-#: The afferent types pooled into the human 86% (Birznieks et al. 2001): no FA-II.
-RECORDED_TYPES = ("SAI", "SAII", "RAI")
+#: The afferent types pooled into the human 86% (Birznieks et al. 2001): no FA-II
+#: (`ddmm.models.afferent_types.AfferentType.recorded_by_humans`).
+RECORDED_TYPES = afferent_type_codes("recorded_by_humans")
 
 
 def tuning_scenes(**kwargs) -> list:

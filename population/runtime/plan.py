@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
+from ddmm.models.afferent_types import AFFERENT_TYPES, afferent_type_codes, normalize_type, type_mask
 from ddmm.models.attenuation import F_TH, UNTUNED
 from ddmm.models.variability import bias_multiplier
 from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
@@ -182,9 +182,12 @@ def _unit_keys(pop, sel, tuned, scale, local):
     theta = np.where(tuned, pop.theta_t[sel], 0.0)
     k = np.where(tuned, pop.k[sel], 0.0)
     columns = [type_code, nap_code, theta, k, scale, pop.sensitivity[sel]]  # sensitivity: gain and dead zone
-    if pop.current.bias_cv_saii > 0.0:  # each SA-II's own tonic current (`bias_multiplier`)
-        tonic = pop.afferent_type[sel] == "SAII"
-        columns.append(np.where(tonic, bias_multiplier(pop.current.bias_cv_saii, pop.afferent_id[sel]), 1.0))
+    spread = {t: cv for t in AFFERENT_TYPES if (cv := pop.current.for_type(t).bias_cv) > 0.0}
+    if spread:  # each unit's own tonic current (`bias_multiplier`; SA-II's ``bias_cv_saii``)
+        multiplier = np.ones(sel.size)
+        for t, cv in spread.items():
+            multiplier = np.where(pop.afferent_type[sel] == t, bias_multiplier(cv, pop.afferent_id[sel]), multiplier)
+        columns.append(multiplier)
     if local:  # each afferent feels its own force, a function of its type and position
         columns += [pop.x_mm[sel], pop.y_mm[sel]]
     return np.column_stack(columns)
@@ -197,14 +200,14 @@ def af_threshold(no_shear: str) -> float:
 
 def _quiet(pop, sel, scene, scale, computes_af, af_constant):
     """Afferents whose noise-free current is identically zero (they never leave rest)."""
-    stretch = pop.afferent_type[sel] == "SAII"
+    stretch = type_mask(pop.afferent_type[sel], "stretch_drive")
     blocked = (pop.nap[sel] != UNTUNED) & (not computes_af) & (af_constant == 0.0) & ~_shallow(pop, sel)
     sheared = _shear_gained(pop, sel) & (scene.max_shear() > 0.0)  # the shear-magnitude term drives them
     pressed = (scale == 0.0) | ((blocked | (not np.any(scene.fz > 0.0))) & ~sheared)
-    bias = pop.current.bias_saii
+    biased = _of_type(pop.afferent_type[sel], [t for t in AFFERENT_TYPES if pop.current.for_type(t).bias != 0.0])
     pressing = pop.current.normal_saii > 0.0 and bool(np.any(scene.fz != 0.0))  # `normal_saii`
     stretched = (scale == 0.0) | ((scene.max_shear() == 0.0) and not pressing)
-    return np.where(stretch, stretched & (bias == 0.0), pressed) & (pop.noise_sigma[sel] == 0.0)
+    return np.where(stretch, stretched, pressed) & ~biased & (pop.noise_sigma[sel] == 0.0)
 
 
 def _excitable(pop, sel) -> np.ndarray:
@@ -231,8 +234,9 @@ def _shear_gained(pop, sel):
 
 
 def _types_where(pop, sel, holds):
-    """Whether each afferent's pressure type (not SA-II) has resolved current parameters for which ``holds``."""
-    types = [t for t in AFFERENT_TYPES if t != "SAII" and holds(pop.current.for_type(t))]
+    """Whether each afferent's pressure type (F_A, not a stretch drive) has resolved current parameters for which
+    ``holds``."""
+    types = [t for t in afferent_type_codes(lambda k: not k.stretch_drive) if holds(pop.current.for_type(t))]
     return _of_type(pop.afferent_type[sel], types)
 
 
@@ -250,7 +254,7 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
     scale = pop.gain[sel] * (1.0 if weights is None else weights)
     noisy = (pop.noise_sigma[sel] > 0) | (pop.noise_cv[sel] > 0) | _excitable(pop, sel)
     if pop.current.phase_saii > 0.0:  # a keyed start phase per (trial, afferent): no unit shares it
-        noisy |= pop.afferent_type[sel] == "SAII"
+        noisy |= type_mask(pop.afferent_type[sel], "phase_spread")
     if not enabled:
         return ConditionPlan(scene.name, scene.n_samples, True, af_constant, weights,
                              np.empty(0, np.int64), np.full(n, -1, np.int64))
@@ -259,7 +263,7 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
     member = np.where(quiet, -2, -1).astype(np.int64)
     units = np.empty(0, np.int64)
     if deterministic.size:
-        stretch = (pop.afferent_type[sel[deterministic]] == "SAII") | _shear_gained(pop, sel[deterministic])
+        stretch = type_mask(pop.afferent_type[sel[deterministic]], "stretch_drive") | _shear_gained(pop, sel[deterministic])
         tuned = (pop.nap[sel[deterministic]] != UNTUNED) & np.where(stretch, scene.max_shear() > 0.0, computes_af)
         keys = _unit_keys(pop, sel[deterministic], tuned, scale[deterministic], local)
         _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
