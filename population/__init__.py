@@ -25,7 +25,8 @@ scipy before a filter is designed.
 from ddmm.utils.lazy import lazy_exports
 
 _WHERE = {
-    "io.arrays": ("from_array", "from_long_csv", "save_array"),
+    "io.arrays": ("from_array", "from_long_csv"),
+    "io.array_writers": ("save_array",),
     "dataset": ("binned_counts", "binned_rates", "describe_dataset", "load_dataset", "psth", "save_dataset"),
     "io.neo_export": ("to_neo",),
     "io.brian2_export": ("to_brian2",),

@@ -10,7 +10,8 @@ A Dataset's own netCDF round trip is `ddmm.population.dataset`.
 from ddmm.utils.lazy import lazy_exports
 
 _WHERE = {
-    "arrays": ("from_array", "from_long_csv", "save_array"),
+    "arrays": ("from_array", "from_long_csv"),
+    "array_writers": ("save_array",),
     "_long_csv": ("read_sites_csv",),
     "nwb": ("to_nwb",),
     "neo_export": ("to_neo",),

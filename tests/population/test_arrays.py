@@ -7,7 +7,7 @@ import xarray as xr
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ddmm.population.io import arrays
+from ddmm.population.io import array_writers, arrays
 from ddmm.population.io.arrays import default_radius, from_array, from_long_csv, save_array
 from ddmm.population.stimuli.scenes import Contact, Scene, Sites, birznieks, taxel_radius
 
@@ -105,13 +105,13 @@ def test_default_radius_is_equal_area_of_median_pitch(tmp_path):
 @pytest.mark.parametrize("ext", EXTS)
 def test_failing_write_leaves_no_file(tmp_path, monkeypatch, ext):
     kind = arrays.EXTENSIONS[ext]
-    real = arrays._WRITERS[kind]
+    real = array_writers._WRITERS[kind]
 
     def half_then_fail(tmp, fields):
         real(tmp, fields)  # the whole file exists under its temporary name...
         raise OSError("disk full")  # ...then the write fails
 
-    monkeypatch.setitem(arrays._WRITERS, kind, half_then_fail)
+    monkeypatch.setitem(array_writers._WRITERS, kind, half_then_fail)
     with pytest.raises(OSError, match="disk full"):
         save_array(tmp_path / f"s{ext}", make_scene())
     assert list(tmp_path.iterdir()) == []
@@ -119,7 +119,7 @@ def test_failing_write_leaves_no_file(tmp_path, monkeypatch, ext):
 
 def test_failing_write_keeps_the_old_file(tmp_path, monkeypatch):
     path = save_array(tmp_path / "s.npz", make_scene(seed=1))
-    monkeypatch.setitem(arrays._WRITERS, "npz", lambda tmp, fields: (_ for _ in ()).throw(OSError("boom")))
+    monkeypatch.setitem(array_writers._WRITERS, "npz", lambda tmp, fields: (_ for _ in ()).throw(OSError("boom")))
     with pytest.raises(OSError):
         save_array(path, make_scene(seed=2))
     assert_same(make_scene(seed=1), from_array(path, conditioning=None))
