@@ -11,6 +11,7 @@ parametrise, and which of them depart from the paper, is described in
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -396,7 +397,7 @@ class TypeCurrentParams:
     transient: float = 0.0
     tau_transient_s: float = 0.05
 
-    @property
+    @cached_property  # read on every streamed push: looked up once per stage
     def signed(self) -> bool:
         """Whether the drive keeps its sign instead of being rectified: a stretch drive's
         (`ddmm.models.afferent_types.AfferentType.stretch_drive`, SA-II's)."""

@@ -253,7 +253,7 @@ def check_force_bound(forces, max_force_n: float, where: str, fs: float | None =
     """
     bound = check_positive(max_force_n, "max_force_n", "N")
     forces = np.asarray(forces, dtype=float)
-    if forces.size == 0:
+    if forces.size == 0 or float(np.abs(forces).max()) * math.sqrt(3.0) <= bound:  # the usual case, cheaply
         return
     magnitude = np.sqrt(np.einsum("...i,...i->...", forces, forces)).reshape(forces.shape[0], -1).max(axis=1)
     beyond = np.flatnonzero(magnitude > bound)
