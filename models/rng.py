@@ -154,7 +154,9 @@ def normals(key: int, afferent_ids, start: int, n_samples: int) -> np.ndarray:
     >>> bool(np.array_equal(a[1, 2:], b[0]))
     True
     """
-    ids = np.ascontiguousarray(afferent_ids, dtype=np.int64)
+    # A writable copy: a read-only array (a pipeline's ids) is another numba signature, a second kernel for a
+    # cold start to load.
+    ids = np.array(afferent_ids, dtype=np.int64, order="C", ndmin=1)
     return _fill(np.uint64(key), ids, int(start), np.empty((ids.size, int(n_samples))))
 
 

@@ -111,7 +111,6 @@ def parse_contact(text):
 
 def _array_scene(args):
     """The sensor-array scene of ``--scene FILE`` (and ``--sites``), or None for any other ``--scene``."""
-    from ddmm.population import from_array, from_long_csv
     suffix = Path(args.scene).suffix.lower()
     is_array = suffix in EXTENSIONS or (suffix == ".csv" and args.sites is not None)
     if args.sites is not None and suffix != ".csv":
@@ -123,6 +122,8 @@ def _array_scene(args):
     if args.theta_r is not None:
         raise ValueError("--theta-r does not apply to a sensor-array scene: the file gives the forces")
     refuse_csv_options(args, args.scene)
+    from ddmm.population import from_array, from_long_csv  # here: the readers cost a named scene 10-15 ms
+
     conditioning = conditioning_from_args(args)
     if suffix in EXTENSIONS:
         return from_array(args.scene, conditioning=conditioning, max_force_n=args.max_force)
