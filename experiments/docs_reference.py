@@ -126,7 +126,8 @@ def _signature(obj) -> str:
         return ""
     params = [p.replace(default=_Default(f"{type(p.default).__name__}()"))
               if p.default is not p.empty and len(repr(p.default)) > 40 else p for p in sig.parameters.values()]
-    return str(sig.replace(parameters=params))
+    # A NamedTuple's fields under postponed annotations are ForwardRefs: show them as the strings they are.
+    return re.sub(r"ForwardRef\('([^']*)'\)", r"'\1'", str(sig.replace(parameters=params)))
 
 
 def _entry(module, name: str) -> str:

@@ -27,6 +27,7 @@ _WHERE = {
     "afferent_types": ("AFFERENT_TYPES", "normalize_type", "type_label"),
     "current_filters": ("filter_force",),
     "current_params": ("CurrentParams",),
+    "type_params": ("TypeParams",),
     "currents": ("afferent_current",),
     "engines": ("ENGINES", "METHODS", "Engine", "NeuronState", "SpikeResult", "get_engine", "integrate",
                 "substeps_for"),

@@ -7,13 +7,100 @@ streaming alike.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numba as nb
 import numpy as np
 
 from ddmm.models.rng import normal_row
 
-__all__ = ["filter_sections", "stage_tail", "receptor_noise_keyed", "stage_kernel", "smooth_kernel", "dynamic_step",
-           "dynamic_kernel", "transduce_inplace", "transduce_columns"]
+__all__ = ["TailState", "StageConstants", "UnitScales", "ReceptorNoise", "filter_sections", "stage_tail",
+           "receptor_noise", "receptor_noise_keyed", "stage_kernel", "smooth_kernel", "dynamic_step", "dynamic_kernel",
+           "transduce_inplace", "transduce_columns"]
+
+
+class TailState(NamedTuple):
+    """The state `stage_tail` carries per afferent (arrays of shape (n_afferents,), updated in place).
+
+    Attributes
+    ----------
+    offset : ndarray
+        Force the filter runs on the deviation from (N; added back when ``order`` is 0).
+    y1 : ndarray
+        Previous filtered deviation (N).
+    y2 : ndarray
+        The one before (N).
+    slow : ndarray
+        Adaptation's slow average (the drive's units).
+    """
+
+    offset: np.ndarray
+    y1: np.ndarray
+    y2: np.ndarray
+    slow: np.ndarray
+
+
+class StageConstants(NamedTuple):
+    """A type's scalar constants of the linear stage after the filter (`stage_tail`).
+
+    Attributes
+    ----------
+    fs : float
+        Sample rate (Hz).
+    order : int
+        Derivative order: 0 (the force), 1 or 2.
+    adapt : float
+        Adaptation depth (dimensionless; 0: none).
+    alpha_adapt : float
+        Adaptation's low-pass coefficient per sample.
+    thresholded : bool
+        Whether the dead zone is subtracted.
+    negative : float
+        Weight of a derivative's negative half-wave (1: absolute value, 0: half-wave).
+    signed : bool
+        Whether the drive keeps its sign (SA-II's stretch), else it is rectified.
+    """
+
+    fs: float
+    order: int
+    adapt: float
+    alpha_adapt: float
+    thresholded: bool
+    negative: float
+    signed: bool
+
+
+class UnitScales(NamedTuple):
+    """Per-afferent scales of the drive (arrays of shape (n_afferents,)).
+
+    Attributes
+    ----------
+    gain : ndarray
+        Stage gain times the afferent's scale and sensitivity.
+    threshold : ndarray
+        Dead zone in the drive's units (`ddmm.models.currents.unit_thresholds`).
+    cv_scale : ndarray
+        Receptor-noise intensity per sample (noise CV over sqrt(ms per sample)).
+    """
+
+    gain: np.ndarray
+    threshold: np.ndarray
+    cv_scale: np.ndarray
+
+
+class ReceptorNoise(NamedTuple):
+    """Receptor-noise draws given in advance (`stage_kernel`'s path; the fused path draws its own, keyed).
+
+    Attributes
+    ----------
+    normals : ndarray
+        Standard normal draws, shape (n_afferents, n_samples) (empty when not ``noisy``).
+    noisy : bool
+        Whether to apply them.
+    """
+
+    normals: np.ndarray
+    noisy: bool
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -37,28 +124,30 @@ def filter_sections(cur, lo, hi, sos, g, n_sections, z):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, thresholded, threshold, negative, gain,
-               normals, col, cv_scale, noisy, signed):
+def stage_tail(x, lo, hi, state, stage, unit):
     """The drive d of afferents ``lo..hi`` from their filtered deviations ``x`` (newtons), in place on ``x``.
 
-    The derivative of ``order``, adaptation, ``gain`` and receptor noise
-    (``normals[:, col]``, rectified unless ``signed``).  ``threshold`` holds
-    each afferent's dead zone in the drive's units (its type's threshold over
-    its sensitivity), subtracted when ``thresholded``.  A derivative
-    (``order`` > 0) is rectified with the weight ``negative`` on its negative
-    half-wave (1.0: the absolute value, the paper's eqs 2-3; 0.0: half-wave
-    rectification, which keeps the phase of a vibration); ``y1``, ``y2`` and
-    ``slow`` are updated in place.  Each step is its own loop over afferents
-    with its branches outside, so the loops vectorise (one loop with all the
-    branches inside ran 10x slower).  With `filter_sections`, the one
-    implementation that `stage_kernel` and the fused streaming kernel
-    (`ddmm.models.fused`) share, so both give the same bits.
+    ``state`` is the `TailState`, ``stage`` the type's `StageConstants` and
+    ``unit`` the `UnitScales`: the derivative of ``order``, adaptation and
+    ``gain`` (rectified unless ``signed``); the receptor noise comes after
+    (`receptor_noise` with draws given, `receptor_noise_keyed` drawing its
+    own).  ``threshold`` holds each afferent's dead zone in the drive's units
+    (its type's threshold over its sensitivity), subtracted when
+    ``thresholded``.  A derivative (``order`` > 0) is rectified with the
+    weight ``negative`` on its negative half-wave (1.0: the absolute value,
+    the paper's eqs 2-3; 0.0: half-wave rectification, which keeps the phase
+    of a vibration); ``y1``, ``y2`` and ``slow`` are updated in place.  Each
+    step is its own loop over afferents with its branches outside, so the
+    loops vectorise (one loop with all the branches inside ran 10x slower).
+    With `filter_sections`, the one implementation that `stage_kernel` and
+    the fused streaming kernel (`ddmm.models.fused`) share, so both give the
+    same bits.
     """
-    fs2 = fs * fs
+    _, order, adapt, alpha_adapt, thresholded, negative, signed = stage
     # Views from 0: loops over range(lo, hi) vectorise worse.
-    x, offset, y1, y2, slow, gain = x[lo:hi], offset[lo:hi], y1[lo:hi], y2[lo:hi], slow[lo:hi], gain[lo:hi]
-    threshold = threshold[lo:hi]
-    n = hi - lo
+    x, offset, y1, y2, slow = x[lo:hi], state.offset[lo:hi], state.y1[lo:hi], state.y2[lo:hi], state.slow[lo:hi]
+    gain, threshold, n, fs = unit.gain[lo:hi], unit.threshold[lo:hi], hi - lo, stage.fs
+    fs2 = fs * fs
     if order == 0:
         for j in range(n):
             cur = x[j]
@@ -98,9 +187,13 @@ def stage_tail(x, lo, hi, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, t
     else:
         for j in range(n):
             x[j] = gain[j] * abs(x[j])
-    if noisy:
-        for j in range(n):
-            x[j] = _noisy(x[j], normals[lo + j, col], cv_scale[lo + j], signed)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def receptor_noise(x, normals, col, cv_scale, signed):
+    """`stage_tail`'s receptor noise from draws given in advance (``normals[:, col]``), in place on ``x``."""
+    for j in range(x.size):
+        x[j] = _noisy(x[j], normals[j, col], cv_scale[j], signed)
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -133,23 +226,26 @@ def receptor_noise_keyed(x, lo, hi, key, afferent_id, sample, cv_scale, signed, 
 
 
 @nb.njit(cache=True, nogil=True)
-def stage_kernel(sos, f_a, offset, zi, y1, y2, slow, fs, order, adapt, alpha_adapt, thresholded, threshold, negative,
-                 gain, normals, cv_scale, noisy, signed):
-    """The linear part of a type's stage: filter (on the deviation from ``offset``), then `stage_tail`.
+def stage_kernel(sos, f_a, zi, state, stage, unit, noise):
+    """The linear part of a type's stage: filter (on the deviation from ``state.offset``), then `stage_tail`.
 
-    ``zi`` has shape (n_sections, 2, n_afferents); ``threshold`` one dead
-    zone per afferent (see `stage_tail`); every state array is updated in place.
+    ``zi`` has shape (n_sections, 2, n_afferents); ``state``, ``stage`` and
+    ``unit`` as `stage_tail` (one dead zone per afferent in
+    ``unit.threshold``); ``noise`` the `ReceptorNoise` (draws of sample n in
+    column n); every state array is updated in place.
     """
     n_samples, m = f_a.shape
     out, cur = np.empty_like(f_a), np.empty(m)
+    offset, (normals, noisy), cv_scale = state.offset, noise, unit.cv_scale
     z = zi.reshape((2 * zi.shape[0], zi.shape[2]))  # a view: section s in rows 2s, 2s + 1
     sections = sos.reshape((1, sos.shape[0], sos.shape[1]))
     for n in range(n_samples):
         for j in range(m):
             cur[j] = f_a[n, j] - offset[j]
         filter_sections(cur, 0, m, sections, 0, sos.shape[0], z)
-        stage_tail(cur, 0, m, offset, y1, y2, slow, fs, order, adapt, alpha_adapt, thresholded, threshold, negative,
-                   gain, normals, n, cv_scale, noisy, signed)
+        stage_tail(cur, 0, m, state, stage, unit)
+        if noisy:
+            receptor_noise(cur, normals, n, cv_scale, stage.signed)
         out[n] = cur
     return out
 

@@ -17,13 +17,17 @@ are the registry's views once the package's types are registered.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+import math
+from dataclasses import dataclass, field, fields
 from operator import attrgetter
 
 import numpy as np
 
+from ddmm.models.neuron import NeuronParams
+from ddmm.models.type_params import TypeParams
+
 __all__ = ["AFFERENT_TYPES", "PAPER_TYPES", "TYPE_LABELS", "AfferentType", "afferent_type_codes",
-           "afferent_type_info", "normalize_type", "register_afferent_type", "type_label", "type_mask"]
+           "afferent_type_info", "is_type", "normalize_type", "register_afferent_type", "type_label", "type_mask"]
 
 
 @dataclass(frozen=True)
@@ -54,7 +58,7 @@ class AfferentType:
     stretch_drive : bool
         Whether its drive is the signed skin-stretch drive
         (`ddmm.models.attenuation.stretch_drive`: the attenuated shear, with
-        ``opponent_saii`` and ``normal_saii``) instead of the attenuated
+        ``SAII.opponent`` and ``SAII.normal``) instead of the attenuated
         force F_A, kept signed through the stage (not rectified); it then
         takes no depth or shear-magnitude term, which shape F_A.
     log_compression : bool
@@ -68,8 +72,22 @@ class AfferentType:
         Sample rate its band needs, as a multiple of its cut-off (RA-II's
         2.5); None: above twice the cut-off (Nyquist) only.
     phase_spread : bool
-        Whether ``phase_saii`` spreads its neurons' start phases over their
-        tonic cycle (`ddmm.models.currents.initial_phase`).
+        Whether `TypeParams.phase` spreads its neurons' start phases over
+        their tonic cycle (`ddmm.models.currents.initial_phase`).
+    current : TypeParams
+        Its current-stage parameters by default (the paper's eqs 1-3 for
+        the paper's types); a population overrides them in
+        `ddmm.models.current_params.CurrentParams`.
+    neuron : NeuronParams
+        Its Izhikevich neuron by default (eqs 4-6); a population overrides
+        it by type (``[neuron.<code>]``).
+    rf_area_mm2 : float
+        Its median receptive-field area in mm^2: the receptive-field law's
+        width (`rf_sigma_mm`; `ddmm.population.anatomy.receptive_fields`).
+    density_share : float or None
+        Its share of the afferents in every region of the hand map
+        (`ddmm.population.anatomy.hand_map`); None: not on the map (a
+        population spec then gives its count).
 
     Examples
     --------
@@ -89,6 +107,10 @@ class AfferentType:
     shared_cutoff: bool = False
     fs_per_cutoff: float | None = None
     phase_spread: bool = False
+    current: TypeParams = field(default_factory=TypeParams)
+    neuron: NeuronParams = field(default_factory=NeuronParams)
+    rf_area_mm2: float = 11.0
+    density_share: float | None = None
 
     def __post_init__(self):
         if not isinstance(self.code, str) or not self.code.isalnum() or self.code != self.code.upper():
@@ -103,6 +125,25 @@ class AfferentType:
         if self.fs_per_cutoff is not None and not (isinstance(self.fs_per_cutoff, (int, float))
                                                    and self.fs_per_cutoff >= 2.0):
             raise ValueError(f"fs_per_cutoff must be a number >= 2 (Nyquist) or None, got {self.fs_per_cutoff!r}")
+        for name, cls in (("current", TypeParams), ("neuron", NeuronParams)):
+            if not isinstance(getattr(self, name), cls):
+                raise TypeError(f"{name} must be a {cls.__name__}, got {type(getattr(self, name)).__name__}")
+        if not _positive_number(self.rf_area_mm2):
+            raise ValueError(f"rf_area_mm2 must be a finite number > 0 (mm^2), got {self.rf_area_mm2!r}")
+        if self.density_share is not None and not (_positive_number(self.density_share) and self.density_share < 1):
+            raise ValueError(f"density_share must be a number in (0, 1) or None, got {self.density_share!r}")
+
+    @property
+    def rf_sigma_mm(self) -> float:
+        """Gaussian fall-off width of its receptive field in mm: a point probe gets weight >= 1/2 within
+        ``sigma sqrt(2 ln 2)``, a disc of area `rf_area_mm2`.
+
+        Examples
+        --------
+        >>> round(afferent_type_info("SAI").rf_sigma_mm, 3)
+        1.589
+        """
+        return float(np.sqrt(self.rf_area_mm2 / np.pi) / np.sqrt(2.0 * np.log(2.0)))
 
     def accepted(self) -> tuple:
         """Every spelling of the type, compacted as `normalize_type` compares them (code, label, spellings).
@@ -113,6 +154,10 @@ class AfferentType:
         ('RAI', 'FAI', 'RA1', 'FA1')
         """
         return tuple(dict.fromkeys(_compact(s) for s in (self.code, self.label, *self.spellings)))
+
+
+def _positive_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value > 0
 
 
 _REGISTRY: dict = {}  # code -> AfferentType, in registration order
@@ -203,6 +248,17 @@ def type_mask(afferent_type, where) -> np.ndarray:
     return out
 
 
+def is_type(afferent_type, code) -> np.ndarray:
+    """Whether each afferent is of the type ``code`` (any accepted spelling): a protocol's selection of units.
+
+    Examples
+    --------
+    >>> is_type(np.array(["SAI", "SAII", "RAI"]), "SA-I").tolist()
+    [True, False, False]
+    """
+    return np.asarray(afferent_type) == normalize_type(code, "code")
+
+
 def type_label(afferent_type: str) -> str:
     """The display label of a type code (``"RAI"`` -> ``"FA-I"``), for figures and text.
 
@@ -235,13 +291,27 @@ def normalize_type(afferent_type, name: str = "afferent_type") -> str:
                      f"{', '.join(_REGISTRY)} or {', '.join(k.label for k in _REGISTRY.values())} (RA-I/RA-II too)")
 
 
-register_afferent_type(AfferentType("SAI", "SA-I", ("SA1",), "tab:blue", in_paper=True, recorded_by_humans=True))
-register_afferent_type(AfferentType("RAI", "FA-I", ("RA1", "FA1"), "tab:orange", in_paper=True,
-                                    recorded_by_humans=True, derivative_order=1, shared_cutoff=True))
-register_afferent_type(AfferentType("RAII", "FA-II", ("RA2", "FA2"), "tab:green", in_paper=True,
-                                    derivative_order=2, shared_cutoff=True, fs_per_cutoff=2.5))
-register_afferent_type(AfferentType("SAII", "SA-II", ("SA2",), "tab:purple", recorded_by_humans=True,
-                                    stretch_drive=True, log_compression=False, phase_spread=True))
+# The package's types.  Currents: the paper's eqs 1-3, gains fitted so that the CMM (AF = 1) press-push-lift
+# response lies near Table III (``experiments/calibration/gains.py``); SA-II's are ours.  Neurons: regular spiking
+# (B = 0.2) for the slowly adapting types, low-threshold spiking (B = 0.25) for the fast ones (eqs 4-6, docs/model.md
+# §1.7).  Receptive-field areas: docs/references.md row 17 (SA-I, FA-I read; SA-II about 5x and FA-II about 10x, read
+# in a secondary source).  Shares: the fingertip's SA-I 70, FA-I 141, FA-II 21, SA-II 9 of 241 units (row 16, R).
+register_afferent_type(AfferentType(
+    "SAI", "SA-I", ("SA1",), "tab:blue", in_paper=True, recorded_by_humans=True,
+    current=TypeParams(gain=5.367),  # fitted: CMM SAI SF 47.5 imp/s (Table III)
+    neuron=NeuronParams(b=0.2), rf_area_mm2=11.0, density_share=70.0 / 241.0))
+register_afferent_type(AfferentType(
+    "RAI", "FA-I", ("RA1", "FA1"), "tab:orange", in_paper=True, recorded_by_humans=True, derivative_order=1,
+    shared_cutoff=True, current=TypeParams(gain=11.036, tau_adapt_s=0.1),  # fitted: CMM RAI SF 15 imp/s
+    neuron=NeuronParams(b=0.25), rf_area_mm2=12.6, density_share=141.0 / 241.0))
+register_afferent_type(AfferentType(
+    "RAII", "FA-II", ("RA2", "FA2"), "tab:green", in_paper=True, derivative_order=2, shared_cutoff=True,
+    fs_per_cutoff=2.5, current=TypeParams(gain=6.162),  # fitted: CMM RAII SF 10 imp/s (Table III)
+    neuron=NeuronParams(b=0.25), rf_area_mm2=10 * 12.6, density_share=21.0 / 241.0))
+register_afferent_type(AfferentType(
+    "SAII", "SA-II", ("SA2",), "tab:purple", recorded_by_humans=True, stretch_drive=True, log_compression=False,
+    phase_spread=True, current=TypeParams(gain=1.0, cutoff_hz=20.0),  # ours: a stretch low-pass at 20 Hz
+    neuron=NeuronParams(b=0.2), rf_area_mm2=5 * 11.0, density_share=9.0 / 241.0))
 
 #: The paper's three afferent types (eqs 1-3).
 PAPER_TYPES = afferent_type_codes("in_paper")

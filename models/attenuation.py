@@ -18,7 +18,7 @@ shear" (docs/model.md §1.5), selected by ``no_shear``:
   forces are.
 
 The physiological presets add a shear-magnitude term to the pressure types'
-F_A (`shear_drive`, ``CurrentParams.shear_<type>``): the same signed
+F_A (`shear_drive`, ``CurrentParams.<TYPE>.shear``): the same signed
 stretch, scaled, so tangential force along an afferent's preferred direction
 raises its drive and against it lowers it.
 
@@ -213,7 +213,7 @@ def stretch_drive(fx, fy, af, opponent: float = 0.0, fz=None, normal: float = 0.
     ``af`` is the profile's AF (shape (n_samples, n_afferents)) on the shear
     direction; stretch along the preferred direction drives the afferent,
     stretch against it lowers the drive when ``opponent > 0``.  With
-    ``normal > 0`` (`CurrentParams.normal_saii`) the normal force ``fz``
+    ``normal > 0`` (`CurrentParams.SAII.normal`) the normal force ``fz``
     (N, shape (n_samples,) or (n_samples, n_afferents)) adds to it.
 
     Examples
@@ -235,8 +235,8 @@ def shear_drive(f_a, fx, fy, af, gain: float, opponent: float = 0.0) -> np.ndarr
 
     ``f_a`` is F_A (shape (n_samples, n_afferents)); ``af`` the profile's own
     AF on the shear direction (`profile_factor`, no threshold), ``gain`` the
-    type's ``CurrentParams.shear_<type>`` and ``opponent`` its
-    ``opponent_shear_<type>``.  With ``gain == 0`` F_A is returned as it is (the
+    type's ``CurrentParams.<TYPE>.shear`` and ``opponent`` its
+    ``<TYPE>.opponent_shear``.  With ``gain == 0`` F_A is returned as it is (the
     paper's drive).  The fused path (`ddmm.models.fused`) runs the same
     arithmetic in the same order.
 
@@ -256,9 +256,10 @@ def shear_drive(f_a, fx, fy, af, gain: float, opponent: float = 0.0) -> np.ndarr
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def profile_value(ux, uy, cos_t, sin_t, k, p1, p2, p3, p4, p5, tip):
+def profile_value(ux, uy, cos_t, sin_t, k, coeffs, tip):
     """One afferent's profile AF for the unit shear vector (ux, uy): the scalar `_af_kernel` and the
-    fused streaming kernel share."""
+    fused streaming kernel share.  ``coeffs`` is the profile's (p1, p2, p3, p4, p5)."""
+    p1, p2, p3, p4, p5 = coeffs
     cos_phi = ux * cos_t + uy * sin_t
     sin_phi = uy * cos_t - ux * sin_t
     r = radius_scalar(sin_phi, cos_phi, k, p1, p2, p3, p4, p5) / tip
@@ -268,11 +269,13 @@ def profile_value(ux, uy, cos_t, sin_t, k, p1, p2, p3, p4, p5, tip):
 
 
 @nb.njit(cache=True, nogil=True)
-def _af_kernel(ux, uy, cos_t, sin_t, k, p1, p2, p3, p4, p5, tip):
+def _af_kernel(ux, uy, cos_t, sin_t, k, coeffs, tip):
+    """AF (n_directions, n_afferents); ``coeffs`` holds the per-afferent arrays p1..p5."""
+    p1, p2, p3, p4, p5 = coeffs
     out = np.empty((ux.size, cos_t.size))
     for i in range(ux.size):
         for j in range(cos_t.size):
-            out[i, j] = profile_value(ux[i], uy[i], cos_t[j], sin_t[j], k[j], p1[j], p2[j], p3[j], p4[j], p5[j],
+            out[i, j] = profile_value(ux[i], uy[i], cos_t[j], sin_t[j], k[j], (p1[j], p2[j], p3[j], p4[j], p5[j]),
                                       tip[j])
     return out
 
@@ -287,7 +290,8 @@ def af_core(ux, uy, cos_t, sin_t, k, params, tip) -> np.ndarray:
     ux, uy = np.ravel(ux).astype(float), np.ravel(uy).astype(float)
     n = np.size(cos_t)
     per = [np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=float), (n,))) for x in (k, *params, tip)]
-    return _af_kernel(ux, uy, np.ravel(cos_t).astype(float), np.ravel(sin_t).astype(float), *per)
+    return _af_kernel(ux, uy, np.ravel(cos_t).astype(float), np.ravel(sin_t).astype(float), per[0], tuple(per[1:6]),
+                      per[6])
 
 
 def attenuated_force(fz, af, depth: float = 1.0) -> np.ndarray:
@@ -300,7 +304,7 @@ def attenuated_force(fz, af, depth: float = 1.0) -> np.ndarray:
     af : array_like, shape (n_samples, n_afferents)
         Attenuation factors from `attenuation_factor`.
     depth : float
-        How deep the attenuation goes, in [0, 1] (``CurrentParams.depth_<type>``;
+        How deep the attenuation goes, in [0, 1] (``CurrentParams.<TYPE>.depth``;
         1, the default, is eq. 18; 0 passes F_Z whatever the direction).
 
     Examples

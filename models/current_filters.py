@@ -18,8 +18,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from ddmm.models._stage_kernels import stage_kernel
-from ddmm.models.afferent_types import AFFERENT_TYPES, afferent_type_info
+from ddmm.models._stage_kernels import ReceptorNoise, StageConstants, TailState, UnitScales, stage_kernel
+from ddmm.models.afferent_types import afferent_type_codes, afferent_type_info
 from ddmm.models.current_params import CurrentParams, TypeCurrentParams
 from ddmm.utils.cache import cache_root
 from ddmm.utils.deprecation import renamed_keyword, warn_renamed
@@ -34,7 +34,7 @@ RAII_FS_FACTOR = afferent_type_info("RAII").fs_per_cutoff
 
 
 @renamed_keyword("types", "afferent_types")
-def check_fs(fs: float, params: CurrentParams, afferent_types=AFFERENT_TYPES) -> None:
+def check_fs(fs: float, params: CurrentParams, afferent_types=None) -> None:
     """Refuse a sample rate too slow for a type's filter band.
 
     A type with `AfferentType.fs_per_cutoff` needs ``fs >= fs_per_cutoff * cutoff``
@@ -46,7 +46,7 @@ def check_fs(fs: float, params: CurrentParams, afferent_types=AFFERENT_TYPES) ->
     ValueError
         Naming the type, its band and the rate needed.
     """
-    for kind in afferent_types:
+    for kind in afferent_type_codes() if afferent_types is None else afferent_types:
         stage = params.for_type(kind)
         if stage.cutoff_hz is None:
             continue
@@ -219,9 +219,10 @@ def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=
     zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
     slow = np.zeros(m)
     # The stage kernel with order 0, unit gain and a signed drive returns exactly deviation + offset.
-    y = stage_kernel(_stage_sos(shared, float(fs)), np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow,
-                      float(fs), 0, 0.0, 0.0, False, np.zeros(m), 1.0, np.ones(m), _NO_NORMALS, np.ones(m), False,
-                      True)
+    tail = TailState(state.offset, y1, y2, slow)
+    y = stage_kernel(_stage_sos(shared, float(fs)), np.ascontiguousarray(f_a), zi, tail,
+                     StageConstants(float(fs), 0, 0.0, 0.0, False, 1.0, True),
+                     UnitScales(np.ones(m), np.zeros(m), np.ones(m)), ReceptorNoise(_NO_NORMALS, False))
     return y, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2, slow=slow, smooth=state.smooth)
 
 

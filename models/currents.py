@@ -2,53 +2,54 @@
 
 The paper's stage (the default of `CurrentParams`):
 
-* SAI follows force:            ``I = g_sai * |F_A|``           (eq. 1)
-* RAI its rate of change:       ``I = g_rai * |dF_A/dt|``       (eq. 2)
-* RAII its acceleration:        ``I = g_raii * |d^2F_A/dt^2|``  (eq. 3)
+* SAI follows force:            ``I = SAI.gain * |F_A|``           (eq. 1)
+* RAI its rate of change:       ``I = RAI.gain * |dF_A/dt|``       (eq. 2)
+* RAII its acceleration:        ``I = RAII.gain * |d^2F_A/dt^2|``  (eq. 3)
 
 with one causal 20 Hz low-pass before the derivatives (docs/model.md §1.6).
 
-Every departure from it is a named field of `CurrentParams`, off by default,
-which the physiological presets switch on (docs/model.md, "What changed in the model"):
+Every departure from it is a named field of each type's `TypeParams` (written
+``<TYPE>.<field>``; `CurrentParams.with_type` sets one), off by default, which
+the physiological presets switch on (docs/model.md, "What changed in the model"):
 
-* **Per-type filters.**  ``cutoff_sai_hz`` low-passes SA-I's force;
-  ``cutoff_rai_hz`` sets RA-I's low-pass before d/dt (a velocity band-pass,
-  best near 10-60 Hz); ``cutoff_raii_hz`` with ``order_raii`` sets RA-II's
+* **Per-type filters.**  ``SAI.cutoff_hz`` low-passes SA-I's force;
+  ``RAI.cutoff_hz`` sets RA-I's low-pass before d/dt (a velocity band-pass,
+  best near 10-60 Hz); ``RAII.cutoff_hz`` with ``RAII.order`` sets RA-II's
   low-pass before d^2/dt^2 (acceleration: sensitivity grows as f^2 up to the
   cut-off and falls beyond it, a Pacinian band-pass near 150-400 Hz).  A
   scene sampled too slowly to carry RA-II's band is refused (`check_fs`).
-* **Phase-preserving rectification.**  ``negative_weight_rai`` and
-  ``negative_weight_raii`` weight the negative half-wave of the derivative
+* **Phase-preserving rectification.**  ``RAI.negative_weight`` and
+  ``RAII.negative_weight`` weight the negative half-wave of the derivative
   (1.0: the paper's absolute value), so that a vibration excites on one
   half-cycle and spikes lock to its phase.
-* **Adaptation.**  ``adapt_rai`` makes RA-I adapt to a sustained velocity
+* **Adaptation.**  ``RAI.adapt`` makes RA-I adapt to a sustained velocity
   (the rectified velocity minus a low-pass of itself).
-* **Slow adaptation of SA-I.**  ``adapt_sai`` adds ``adapt * (y - slow)``,
+* **Slow adaptation of SA-I.**  ``SAI.adapt`` adds ``adapt * (y - slow)``,
   where ``slow`` is a first-order low-pass of the filtered force with time
-  constant ``tau_adapt_sai_s``: a dynamic loading response that decays
+  constant ``SAI.tau_adapt_s``: a dynamic loading response that decays
   through a hold, and silence during unloading (the drive is rectified).
 * **SA-II (Ruffini), a fourth type.**  Driven by skin stretch, from forces
-  the attenuated *shear*: ``x = F_S * (AF - opponent_saii * (1 - AF))`` (so
+  the attenuated *shear*: ``x = F_S * (AF - SAII.opponent * (1 - AF))`` (so
   stretch against the preferred direction lowers the rate), low-passed at
-  ``cutoff_saii_hz``, on top of a tonic ``bias_saii`` current.  Options:
-  ``normal_saii`` adds the normal force to the drive, ``bias_cv_saii``
+  ``SAII.cutoff_hz``, on top of a tonic ``SAII.bias`` current.  Options:
+  ``SAII.normal`` adds the normal force to the drive, ``SAII.bias_cv``
   spreads the tonic current across units (keyed by afferent id) and
-  ``phase_saii`` starts each neuron at its own keyed phase.
-* **SA-I dynamics on the current.**  ``dynamic_sai`` and ``fall_sai`` act
+  ``SAII.phase`` starts each neuron at its own keyed phase.
+* **SA-I dynamics on the current.**  ``SAI.dynamic`` and ``SAI.fall`` act
   after the transducer: ``I + dynamic (I - J) - fall J`` with ``J`` a
-  low-pass of the current (``tau_dynamic_sai_s``): an overshoot in fast
+  low-pass of the current (``SAI.tau_dynamic_s``): an overshoot in fast
   loading and a fractional fall through a hold at every force.
-  ``transient_sai`` adds ``transient max(R - K, 0)``, a rectified band-pass of the current
-  (first-order low-passes of ``tau_transient_sai_s / 2`` and
-  ``tau_transient_sai_s``): SA-I's peak rates while the load rises.
-* **Shear magnitude in the pressure types' drive.**  ``shear_sai``,
-  ``shear_rai`` and ``shear_raii`` add a stretch-like term to F_A before the
-  type's filter, ``x = max(0, F_A + shear_<type> * F_S * (AF - opponent_shear_<type> * (1 - AF)))``
+  ``SAI.transient`` adds ``transient max(R - K, 0)``, a rectified band-pass of the current
+  (first-order low-passes of ``SAI.tau_transient_s / 2`` and
+  ``SAI.tau_transient_s``): SA-I's peak rates while the load rises.
+* **Shear magnitude in the pressure types' drive.**  ``SAI.shear``,
+  ``RAI.shear`` and ``RAII.shear`` add a stretch-like term to F_A before the
+  type's filter, ``x = max(0, F_A + <TYPE>.shear * F_S * (AF - <TYPE>.opponent_shear * (1 - AF)))``
   (AF the profile's own, `attenuation.shear_drive`): tangential force along
   the preferred direction raises the drive, against it lowers it, growing
   with F_S (FA-I and FA-II see its derivatives during a tangential ramp).
   The paper's F_A alone only attenuates: shear can never raise a rate.
-* **Saturating transducers.**  ``i_max_<type>`` bounds the current:
+* **Saturating transducers.**  ``<TYPE>.i_max`` bounds the current:
   ``I = i_max * tanh(d / i_max)`` for the linear drive ``d = g * x``, so
   rates stay physiological on fast ramps.  The older log compression
   ``i_sat`` (``I = i_sat * log1p(d / i_sat)``, unbounded) is kept.
@@ -56,7 +57,7 @@ which the physiological presets switch on (docs/model.md, "What changed in the m
   (``noise_cv``, a population property) multiplies the linear drive before
   the transducer, ``d (1 + cv * xi / sqrt(h))`` (rectified), so an undriven
   afferent stays silent and the bound ``i_max`` holds with noise; then
-  ``tau_<type>_s`` low-passes the current (first order).  The Izhikevich
+  ``<TYPE>.tau_s`` low-passes the current (first order).  The Izhikevich
   neuron with the paper's D = 8 fires its first interval far faster than its
   steady rate when its current *steps* (I = 100 mV/ms: 1/ISI 1,400 Hz, then
   230 Hz); a current that rises over ~10 ms keeps the first interval near
@@ -78,7 +79,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models._stage_kernels import dynamic_kernel, smooth_kernel, stage_kernel, transduce_inplace
+from ddmm.models._stage_kernels import (
+    ReceptorNoise,
+    StageConstants,
+    TailState,
+    UnitScales,
+    dynamic_kernel,
+    smooth_kernel,
+    stage_kernel,
+    transduce_inplace,
+)
 from ddmm.models.afferent_types import AFFERENT_TYPES, PAPER_TYPES, TYPE_LABELS, normalize_type, type_label
 from ddmm.models.current_filters import (
     _NO_NORMALS,
@@ -158,7 +168,7 @@ def afferent_current(
         field weight), applied before the transducer.
     sensitivity : array_like, shape (n_afferents,), optional
         Each afferent's sensitivity (dimensionless, > 0; default 1): it
-        multiplies the gain and divides the type's dead zone (``threshold_rai``),
+        multiplies the gain and divides the type's dead zone (``RAI.threshold``),
         so the unit's stimulus thresholds are its type's over its
         sensitivity (docs/model.md, "Units that differ").
 
@@ -173,7 +183,7 @@ def afferent_current(
     Examples
     --------
     >>> f = np.linspace(0.0, 1.0, 1001)[:, None]          # 1 N/s ramp at 1 kHz
-    >>> i, _ = afferent_current(f, 1000.0, "RAI", CurrentParams(g_rai=1.0))
+    >>> i, _ = afferent_current(f, 1000.0, "RAI", CurrentParams().with_type("RAI", gain=1.0))
     >>> round(float(i[-1, 0]), 2)                          # settles at 1 N/s
     1.0
     """
@@ -223,10 +233,11 @@ def current_core(f_a, fs, afferent_type, params, state=None, scale=None, normals
     slow = np.zeros(m) if state.slow is None else state.slow.copy()
     gain = gain if np.ndim(gain) else np.full(m, gain)
     cv_scale = np.asarray(noise_cv, dtype=float) / np.sqrt(1000.0 / fs) if noisy else gain
-    drive = stage_kernel(sos, np.ascontiguousarray(f_a), state.offset, zi, y1, y2, slow, fs, st.derivative,
-                         float(st.adapt), alpha_adapt, st.threshold > 0.0, unit_thresholds(st, sensitivity, m),
-                         float(st.negative_weight), gain,
-                         np.ascontiguousarray(normals) if noisy else _NO_NORMALS, cv_scale, noisy, st.signed)
+    stage = StageConstants(fs, st.derivative, float(st.adapt), alpha_adapt, st.threshold > 0.0,
+                           float(st.negative_weight), st.signed)
+    noise = ReceptorNoise(np.ascontiguousarray(normals) if noisy else _NO_NORMALS, noisy)
+    drive = stage_kernel(sos, np.ascontiguousarray(f_a), zi, TailState(state.offset, y1, y2, slow), stage,
+                         UnitScales(gain, unit_thresholds(st, sensitivity, m), cv_scale), noise)
     current = transduce_inplace(drive, st, excite)  # numpy's vectorised log1p/tanh: 5-10x numba's scalar calls
     current, smooth, dyn, fast, rise = _after_transducer(current, st, state, m, fs, alpha_smooth, afferent_id)
     return current, FilterState(zi, state.offset, y1, y2, slow, smooth, dyn, fast, rise)
@@ -240,7 +251,7 @@ def unit_thresholds(stage: TypeCurrentParams, sensitivity, n: int) -> np.ndarray
 
     Examples
     --------
-    >>> st = CurrentParams(threshold_rai=1.0).for_type("RAI")
+    >>> st = CurrentParams().with_type("RAI", threshold=1.0).for_type("RAI")
     >>> unit_thresholds(st, np.array([0.5, 2.0]), 2).tolist()
     [2.0, 0.5]
     """

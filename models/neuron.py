@@ -23,14 +23,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
 from ddmm.utils.validation import as_finite_array, shown
 
 __all__ = [
     "V_PEAK",
     "V_FLOOR",
     "NeuronParams",
-    "NEURON_PARAMS",
+    "NEURON_PARAMS",  # noqa: F822 (a view of the registry: the module's __getattr__)
     "resting_state",
     "neuron_arrays",
     "refractory_steps",
@@ -90,13 +89,12 @@ class NeuronParams:
                 raise ValueError(f"{name} must be a finite number {allowed}, got {shown}")
 
 
-#: Parameters per type: SAI and SAII regular spiking, RAI and RAII low-threshold spiking.
-NEURON_PARAMS: dict[str, NeuronParams] = {
-    "SAI": NeuronParams(b=0.2),
-    "RAI": NeuronParams(b=0.25),
-    "RAII": NeuronParams(b=0.25),
-    "SAII": NeuronParams(b=0.2),
-}
+def __getattr__(name):
+    if name == "NEURON_PARAMS":  # a view of the registry (`AfferentType.neuron`), whatever is registered now
+        from ddmm.models.afferent_types import afferent_type_codes, afferent_type_info
+
+        return {code: afferent_type_info(code).neuron for code in afferent_type_codes()}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def resting_state(b) -> tuple[np.ndarray, np.ndarray]:
@@ -141,11 +139,13 @@ def check_neuron(neuron, name: str = "neuron") -> None:
     --------
     >>> check_neuron({"RAII": NeuronParams(a=0.5, b=0.25, d=100.0)})
     """
+    from ddmm.models.afferent_types import afferent_type_codes  # the registry imports this module
+
     if not isinstance(neuron, dict):
         raise TypeError(f"{name} must be a dict of NeuronParams by afferent type, got {type(neuron).__name__}")
     for kind, params in neuron.items():
-        if kind not in AFFERENT_TYPES:
-            raise ValueError(f"{name}: unknown afferent type {kind!r}; allowed: {', '.join(AFFERENT_TYPES)}")
+        if kind not in afferent_type_codes():
+            raise ValueError(f"{name}: unknown afferent type {kind!r}; allowed: {', '.join(afferent_type_codes())}")
         if not isinstance(params, NeuronParams):
             raise TypeError(f"{name}.{kind} must be a NeuronParams, got {type(params).__name__}")
 
@@ -156,9 +156,9 @@ def neuron_arrays(afferent_type, params: dict[str, NeuronParams] | None = None):
     Parameters
     ----------
     afferent_type : str or sequence of str
-        ``"SAI"``, ``"RAI"`` or ``"RAII"`` per afferent.
+        A type code (or accepted spelling) per afferent.
     params : dict, optional
-        Overrides of `NEURON_PARAMS`, keyed by type.
+        Overrides of each type's registered neuron (`AfferentType.neuron`), keyed by type code.
 
     Returns
     -------
@@ -171,15 +171,15 @@ def neuron_arrays(afferent_type, params: dict[str, NeuronParams] | None = None):
     >>> neuron_arrays(["SAI", "RAI"])["b"].tolist()
     [0.2, 0.25]
     """
-    table = dict(NEURON_PARAMS, **(params or {}))
+    from ddmm.models.afferent_types import afferent_type_info  # the registry imports this module
+
     types = np.atleast_1d(np.asarray(afferent_type, dtype=object))
-    codes = {t: normalize_type(t) for t in set(types.tolist())}
-    if any(t != c for t, c in codes.items()):
-        types = np.array([codes[t] for t in types.tolist()], dtype=object)
+    kinds = {t: afferent_type_info(t) for t in set(types.tolist())}
+    table = {t: (params or {}).get(kind.code, kind.neuron) for t, kind in kinds.items()}
     out = {}
     for field in ("a", "b", "c", "d", "t_ref"):
-        lookup = {t: getattr(table[t], field) for t in AFFERENT_TYPES}
-        out[field] = np.array([lookup[t] for t in types], dtype=float)
+        lookup = {t: getattr(p, field) for t, p in table.items()}
+        out[field] = np.array([lookup[t] for t in types.tolist()], dtype=float)
     return out
 
 

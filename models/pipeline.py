@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, afferent_type_codes, type_mask
+from ddmm.models.afferent_types import afferent_type_codes
 from ddmm.models.attenuation import (
     F_TH,
     attenuated_force,
@@ -82,10 +82,10 @@ def compute_currents(
     check_instance(current_params, "current_params", CurrentParams, "a CurrentParams")
     theta = np.atleast_1d(as_finite_array(theta_t, "theta_t"))
     types = np.broadcast_to(np.asarray(afferent_type, dtype=object), (theta.size,))
-    unknown = sorted(set(types) - set(AFFERENT_TYPES), key=str)
+    unknown = sorted(set(types) - set(afferent_type_codes()), key=str)
     if unknown:
         raise ValueError(
-            f"afferent_type={unknown[0]!r} is unknown; allowed: {', '.join(AFFERENT_TYPES)}"
+            f"afferent_type={unknown[0]!r} is unknown; allowed: {', '.join(afferent_type_codes())}"
         )
     af = attenuation_factor(fx, fy, theta, profile, k, f_th=f_th, no_shear=no_shear)
     drive = attenuated_force(fz, af)
@@ -97,12 +97,14 @@ def compute_currents(
         if cols.size and stage.shear != 0.0:
             raw = profile_factor(fx, fy, theta[cols], profile, np.broadcast_to(k, theta.shape)[cols])
             drive[:, cols] = shear_drive(drive[:, cols], fx, fy, raw, stage.shear, stage.opponent_shear)
-    stretch = np.flatnonzero(type_mask(types, "stretch_drive"))
-    if stretch.size:  # a stretch drive (SA-II's): the attenuated shear (skin stretch), not the normal force
-        raw = profile_factor(fx, fy, theta[stretch], profile, np.broadcast_to(k, theta.shape)[stretch])
-        drive[:, stretch] = stretch_drive(fx, fy, raw, current_params.opponent_saii, fz, current_params.normal_saii)
+    for kind in afferent_type_codes("stretch_drive"):  # SA-II's: the attenuated shear (skin stretch), not F_Z
+        cols = np.flatnonzero(types == kind)
+        if cols.size:
+            stage = current_params.for_type(kind)
+            raw = profile_factor(fx, fy, theta[cols], profile, np.broadcast_to(k, theta.shape)[cols])
+            drive[:, cols] = stretch_drive(fx, fy, raw, stage.opponent, fz, stage.normal)
     current = np.empty_like(drive)
-    for kind in AFFERENT_TYPES:
+    for kind in afferent_type_codes():
         cols = np.flatnonzero(types == kind)
         if cols.size:
             current[:, cols], _ = afferent_current(drive[:, cols], fs, kind, current_params)

@@ -14,6 +14,8 @@ are continuous.  ``tests/models/test_reference.py`` checks it against
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numba as nb
 import numpy as np
 
@@ -21,6 +23,33 @@ from ddmm.models.neuron import V_PEAK
 from ddmm.utils.validation import shown
 
 __all__ = ["reference_spike_times"]
+
+
+class ReferenceCell(NamedTuple):
+    """One neuron's constants for the reference solver's kernels (eqs 4-6).
+
+    Attributes
+    ----------
+    a : float
+        Recovery rate (1/ms).
+    b : float
+        Sensitivity of u to v (dimensionless).
+    c : float
+        Reset potential (mV).
+    d : float
+        Reset increment of u (mV/ms).
+    t_ref : float
+        Absolute refractory period (ms): v held at c after a spike.
+    v_peak : float
+        Spike cut-off (mV).
+    """
+
+    a: float
+    b: float
+    c: float
+    d: float
+    t_ref: float
+    v_peak: float
 
 
 @nb.njit(cache=True, inline="always")
@@ -69,11 +98,15 @@ def _hold(u, hold, remaining, a, b, c):
 
 
 @nb.njit(cache=True)
-def _advance(v, u, hold, i, a, b, c, d, t_ref, h, t, v_peak, out, n):
-    """Integrate [t, t + h]: RK4, then split at every crossing and hold v for ``t_ref`` ms after it.
+def _advance(v, u, hold, i, cell, h, t, out, n):
+    """Integrate [t, t + h]: RK4, then split at every crossing and hold v for ``cell.t_ref`` ms after it.
 
-    Returns (v, u, refractory time left in ms, n).
+    ``v``, ``u`` and ``hold`` (refractory time left in ms) are the state
+    before, ``i`` the current and ``cell`` the neuron's `ReferenceCell`;
+    spike times go to ``out`` from position ``n``.  Returns (v, u,
+    refractory time left in ms, n).
     """
+    a, b, c, d, t_ref, v_peak = cell
     remaining = h
     while remaining > 0.0:
         if hold > 0.0:
@@ -96,13 +129,14 @@ def _advance(v, u, hold, i, a, b, c, d, t_ref, h, t, v_peak, out, n):
 
 
 @nb.njit(cache=True, nogil=True)
-def _solve_one(current, sample_ms, steps, a, b, c, d, t_ref, v, u, v_peak, out):
+def _solve_one(current, sample_ms, steps, cell, v, u, out):
+    """Spike times (ms) of one neuron from (``v``, ``u``) into ``out``; returns how many (may exceed its size)."""
     h = sample_ms / steps
     n, hold = 0, 0.0
     for k in range(current.size):
         for s in range(steps):
             t = k * sample_ms + s * h
-            v, u, hold, n = _advance(v, u, hold, current[k], a, b, c, d, t_ref, h, t, v_peak, out, n)
+            v, u, hold, n = _advance(v, u, hold, current[k], cell, h, t, out, n)
     return n
 
 
@@ -140,8 +174,9 @@ def reference_spike_times(current, fs: float, params: dict, v0, u0, *, dt_ref: f
         cap = max(64, int(current.shape[1] * sample_ms))  # at most one spike per ms is generous here
         while True:
             out = np.empty(cap)
-            n = _solve_one(current[j], sample_ms, steps, params["a"][j], params["b"][j], params["c"][j],
-                           params["d"][j], float(t_ref_ms[j]), float(v0[j]), float(u0[j]), V_PEAK, out)
+            cell = ReferenceCell(params["a"][j], params["b"][j], params["c"][j], params["d"][j], float(t_ref_ms[j]),
+                                 V_PEAK)
+            n = _solve_one(current[j], sample_ms, steps, cell, float(v0[j]), float(u0[j]), out)
             if n <= cap:
                 break
             cap = n

@@ -28,7 +28,6 @@ Schema (names are fixed):
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 from importlib import metadata
 from pathlib import Path
@@ -37,11 +36,11 @@ import numba as nb
 import numpy as np
 import xarray as xr
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, afferent_type_codes, type_label
+from ddmm.models.afferent_types import afferent_type_codes, afferent_type_info, type_label
 from ddmm.models.attenuation import F_TH
 from ddmm.models.metrics import CONTACT_THRESHOLD
-from ddmm.models.neuron import NEURON_PARAMS, V_PEAK
-from ddmm.population.anatomy.receptive_fields import RF_SIGMA_MM, RF_SUPPORT
+from ddmm.models.neuron import V_PEAK
+from ddmm.population.anatomy.receptive_fields import RF_SUPPORT
 from ddmm.utils.files import read_netcdf, write_netcdf
 from ddmm.utils.validation import check_choice, check_dataset, check_positive
 
@@ -70,19 +69,17 @@ def model_attrs(population, config) -> dict:
         "frame": "+X radial, +Y distal; theta 0 radial, 90 distal, 180 ulnar, 270 proximal; theta_t in the "
                  "afferent's local digit frame, frame_deg (counterclockwise) rotates it to the hand frame",
         "f_th": F_TH, "contact_threshold": CONTACT_THRESHOLD, "v_peak": V_PEAK,
-        **{f"current_{f.name}": "none" if getattr(cp, f.name) is None else getattr(cp, f.name)
-           for f in dataclasses.fields(cp)},
-        **{f"current_i_sat_{t.lower()}": "none" if cp.saturation(t) is None else cp.saturation(t)
-           for t in afferent_type_codes("log_compression")},
+        **{f"current_{name}": "none" if value is None else value for name, value in cp.flat().items()},
         "noise_model": "white Gaussian current, (noise_sigma + noise_cv |I|)/sqrt(h) per sample of h ms",
         "rf_support": RF_SUPPORT,
         "receptive_field": population.receptive_field,
     }
-    for kind, params in {**NEURON_PARAMS, **population.neuron}.items():
+    for kind in afferent_type_codes():
+        params = population.neuron.get(kind, afferent_type_info(kind).neuron)
         for name in ("a", "b", "c", "d", "t_ref"):  # t_ref in s
             attrs[f"neuron_{kind}_{name}"] = getattr(params, name)
-    for kind, sigma in RF_SIGMA_MM.items():
-        attrs[f"rf_sigma_{kind}_mm"] = sigma
+    for kind in afferent_type_codes():
+        attrs[f"rf_sigma_{kind}_mm"] = afferent_type_info(kind).rf_sigma_mm
     return attrs
 
 
@@ -394,7 +391,7 @@ def describe_dataset(ds: xr.Dataset) -> str:
              f"seed {ds.attrs['seed']}, no_shear {ds.attrs['no_shear']} (eq. 17's reading below the shear "
              f"threshold; docs/model.md), ddmm {ds.attrs['ddmm_version']}"]
     present = set(ds.afferent_type.values.tolist())
-    kinds = [t for t in AFFERENT_TYPES if t in present]
+    kinds = [t for t in afferent_type_codes() if t in present]
     for c, name in enumerate(ds.condition.values):
         counts = ds.spike_count.isel(condition=c)
         dur = float(ds.duration[c])

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
+from ddmm.models.afferent_types import afferent_type_codes, normalize_type
 from ddmm.models.attenuation import UNTUNED
 from ddmm.models.current_params import CurrentParams
 from ddmm.models.nap import PROFILE_NAMES, k_from_selectivity, validate_k
@@ -153,13 +153,13 @@ class Population:
 
     def counts(self) -> dict:
         """Afferents per type."""
-        return {t: int(np.sum(self.afferent_type == t)) for t in AFFERENT_TYPES if np.any(self.afferent_type == t)}
+        return {t: int(np.sum(self.afferent_type == t)) for t in afferent_type_codes() if np.any(self.afferent_type == t)}
 
 
 def _validate_values(pop: Population) -> None:
-    bad = sorted(set(pop.afferent_type.tolist()) - set(AFFERENT_TYPES))
+    bad = sorted(set(pop.afferent_type.tolist()) - set(afferent_type_codes()))
     if bad:
-        raise ValueError(f"afferent_type={bad[0]!r} is unknown; allowed: {', '.join(AFFERENT_TYPES)}")
+        raise ValueError(f"afferent_type={bad[0]!r} is unknown; allowed: {', '.join(afferent_type_codes())}")
     bad = sorted(set(pop.nap.tolist()) - set(NAP_CHOICES))
     if bad:
         raise ValueError(f"nap={bad[0]!r} is unknown; allowed: {', '.join(NAP_CHOICES)}")
@@ -274,7 +274,7 @@ def _sample_sensitivity(sd: float, n: int, kind: str, rng) -> np.ndarray:
     if sd == 0.0 or n == 0:
         return np.ones(n)
     seq = getattr(rng.bit_generator, "seed_seq", None)
-    tag = (SENSITIVITY_TAG, AFFERENT_TYPES.index(kind))
+    tag = (SENSITIVITY_TAG, afferent_type_codes().index(kind))
     if isinstance(seq, np.random.SeedSequence):
         seq = np.random.SeedSequence(seq.entropy, spawn_key=tuple(seq.spawn_key) + tag, pool_size=seq.pool_size)
     else:

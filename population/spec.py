@@ -22,8 +22,10 @@ TOML layout (every table optional unless marked)::
     # [map]
     # name = "hand"                # counts from the map's densities (row 16)
     # regions = ["D2d", "D2m"]     # optional subset (default: every region)
-    [current]                      # overrides of ddmm.models.CurrentParams
-    g_sai = 5.367
+    [current]                      # overrides of ddmm.models.CurrentParams: shared fields,
+    cutoff_hz = 20.0               #   then a table of ddmm.models.TypeParams fields per type
+    [current.SAI]
+    gain = 5.367
     [types.SAI]                    # one table per type present
     count = 282                    # or density_per_cm2 = 70.0
     noise_sigma = 1.0              # mV/sqrt(ms), additive
@@ -46,18 +48,20 @@ import functools
 import math
 import os
 import tomllib
+import warnings
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, normalize_type
+from ddmm.models.afferent_types import afferent_type_codes, afferent_type_info, normalize_type
 from ddmm.models.attenuation import UNTUNED
-from ddmm.models.current_params import CurrentParams
+from ddmm.models.current_params import LEGACY_FIELDS, CurrentParams
 from ddmm.models.nap import PROFILE_NAMES
-from ddmm.models.neuron import NEURON_PARAMS, NeuronParams, check_neuron
+from ddmm.models.neuron import NeuronParams, check_neuron
+from ddmm.models.type_params import TypeParams
 from ddmm.population.anatomy import hand_map
 from ddmm.population.anatomy.receptive_fields import check_shape
-from ddmm.utils.deprecation import renamed_keyword
+from ddmm.utils.deprecation import renamed_keyword, warn_renamed
 from ddmm.utils.validation import check_instance, shown
 
 __all__ = [
@@ -400,9 +404,9 @@ class PopulationSpec:
         check_shape(self.receptive_field)  # one message for a spec, a population and a weight call
         check_neuron(self.neuron)
         for kind in self.types:
-            if kind not in AFFERENT_TYPES:
-                _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)}")
-        ordered = {k: self.types[k] for k in AFFERENT_TYPES if k in self.types}
+            if kind not in afferent_type_codes():
+                _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(afferent_type_codes())}")
+        ordered = {k: self.types[k] for k in afferent_type_codes() if k in self.types}
         object.__setattr__(self, "types", ordered)
         if self.map is not None and not isinstance(self.map, MapSpec):
             raise TypeError(f"map must be a MapSpec or None, got {type(self.map).__name__}")
@@ -489,7 +493,7 @@ def spec_from_dict(data: dict, *, default_name: str = "custom") -> PopulationSpe
         try:
             codes[kind] = normalize_type(kind)
         except ValueError:
-            _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)} "
+            _fail(f"types.{kind}", f"unknown afferent type; allowed: {', '.join(afferent_type_codes())} "
                                    "(or SA-I, FA-I, FA-II, SA-II)")
     if len(set(codes.values())) != len(codes):
         _fail("types", f"two tables name one afferent type: {', '.join(codes)}")
@@ -499,7 +503,7 @@ def spec_from_dict(data: dict, *, default_name: str = "custom") -> PopulationSpe
     return _build(PopulationSpec, data, "", {
         "types": lambda d, k: {kind: _type_spec(t, f"types.{kind}") for kind, t in d.items()},
         "region": lambda d, k: _build(Region, d, "region"),
-        "current": lambda d, k: _build(CurrentParams, d, "current"),
+        "current": _current_table,
         "map": lambda d, k: _build(MapSpec, d, "map"),
         "neuron": _neuron_table,
     })
@@ -514,12 +518,47 @@ def _neuron_table(data, key) -> dict:
         try:
             code = normalize_type(kind)
         except ValueError:
-            _fail(f"{key}.{kind}", f"unknown afferent type; allowed: {', '.join(AFFERENT_TYPES)}")
-        base = NEURON_PARAMS[code]
+            _fail(f"{key}.{kind}", f"unknown afferent type; allowed: {', '.join(afferent_type_codes())}")
+        base = afferent_type_info(code).neuron
         built = _build(NeuronParams, {**dataclasses.asdict(base), **table} if isinstance(table, dict) else table,
                        f"{key}.{kind}")
         out[code] = built
     return out
+
+
+def _current_table(data, key) -> CurrentParams:
+    """``[current]``: the shared fields, and ``[current.<TYPE>]`` tables of `TypeParams` fields, each starting
+    from the type's registered defaults.  The old flat keys (``g_sai``) still work for one release."""
+    if not isinstance(data, dict):
+        _fail(key, f"must be a table, got {type(data).__name__}")
+    shared, types, legacy = {}, {}, {}
+    for name, value in data.items():
+        if isinstance(value, dict):
+            try:
+                code = normalize_type(name)
+            except ValueError:
+                _fail(f"{key}.{name}", f"unknown afferent type; allowed: {', '.join(afferent_type_codes())}")
+            base = dataclasses.asdict(afferent_type_info(code).current)
+            unknown = sorted(set(value) - set(base))
+            if unknown:
+                _fail(f"{key}.{name}.{unknown[0]}", f"unknown key; allowed: {', '.join(base)}")
+            types[code] = _build(TypeParams, {**base, **value}, f"{key}.{name}")
+        elif name in ("cutoff_hz", "filter_order", "i_sat"):
+            shared[name] = value
+        elif name in LEGACY_FIELDS:
+            legacy[name] = value
+        else:
+            _fail(f"{key}.{name}", "unknown key; allowed: cutoff_hz, filter_order, i_sat and a table per afferent "
+                                   f"type ([{key}.SAI], ...)")
+    for name in legacy:
+        code, field = LEGACY_FIELDS[name]
+        warn_renamed(f"[{key}] {name}", f"[{key}.{code}] {field}", stacklevel=6)
+    try:
+        with warnings.catch_warnings():  # warned above, in the file's terms
+            warnings.simplefilter("ignore", DeprecationWarning)
+            return CurrentParams(**shared, types=types, **legacy)
+    except (TypeError, ValueError) as exc:
+        _fail(key, str(exc))
 
 
 @functools.lru_cache(maxsize=None)

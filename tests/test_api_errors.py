@@ -179,7 +179,7 @@ ROWS = [
     (ddmm.simulate, {"population": POP, "scenes": SCENE, "engine": "direct", "chunk_size": 0}, "chunk_size"),
     (ddmm.simulate, {"population": POP, "scenes": SCENE, "engine": "direct", "time_chunk": -1}, "time_chunk"),
     # ---- ddmm.models ----
-    (M.CurrentParams, {"g_sai": "x"}, "g_sai"),
+    (M.CurrentParams, {"cutoff_hz": "x"}, "cutoff_hz"),
     (M.CurrentParams, {"cutoff_hz": -1.0}, "cutoff_hz"),
     (M.CurrentParams, {"filter_order": 0}, "filter_order"),
     (M.CurrentParams, {"i_sat": NAN}, "i_sat"),
@@ -187,6 +187,7 @@ ROWS = [
     (M.NeuronParams, {"t_ref": -1.0}, "t_ref"),
     (M.NeuronState, {"v": "x", "u": [0.0]}, "v"),
     (M.NeuronState, {"v": [0.0], "u": None}, "u"),
+    (M.TypeParams, {"gain": "x"}, "gain"),
     (M.afferent_current, {"f_a": "x", "fs": 1000.0, "afferent_type": "SAI"}, "f_a"),
     (M.afferent_current, {"f_a": np.ones((3, 1)), "fs": -1.0, "afferent_type": "SAI"}, "fs"),
     (M.afferent_current, {"f_a": np.ones((3, 1)), "fs": 1000.0, "afferent_type": 5}, "afferent_type"),

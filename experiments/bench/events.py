@@ -34,7 +34,7 @@ import math
 
 import numpy as np
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, type_label
+from ddmm.models.afferent_types import afferent_type_codes, type_label
 from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.utils.validation import as_finite_array, check_positive
 
@@ -154,7 +154,7 @@ def first_spikes(afferent, time_s, afferent_type, event_s: float, window_s: floa
     latency_ms = np.maximum((when[index] - event_s) * 1e3, 0.0)  # a spike at the event's own time: 0, not -0
     kinds = np.asarray(afferent_type).astype(str)[firsts]
     out = {}
-    for kind in AFFERENT_TYPES:
+    for kind in afferent_type_codes():
         mine = latency_ms[kinds == kind]
         out[type_label(kind)] = {"median_ms": round(float(np.median(mine)), 2) if mine.size else None,
                                  "n": int(mine.size)}
@@ -395,7 +395,7 @@ def _lsl_figures(one, repeats: int, pushed, anchor: float, arrivals, types) -> d
         for event, k in (("contact", on + j * one.shape[0]), ("release", off + j * one.shape[0])):
             event_s = k / 1000.0
             near = (model_s >= event_s - 1e-6) & (model_s < event_s + WINDOW_S)  # stamps: ~1e-12 s off
-            for label in (type_label(t) for t in AFFERENT_TYPES):
+            for label in (type_label(t) for t in afferent_type_codes()):
                 mine = np.flatnonzero(near & (kind == label))
                 if mine.size:
                     i = mine[np.argmin(arrived[mine])]
@@ -441,7 +441,7 @@ def format_event_case(case: dict) -> list:
         return [f"{case['name']}: skipped: {case['skipped']}"]
     if "lsl" in case:
         return _format_lsl(case)
-    labels = [type_label(t) for t in AFFERENT_TYPES]
+    labels = [type_label(t) for t in afferent_type_codes()]
     lines = [(f"{case['name']}: input {case['fs_hz']:g} Hz, model {case['model_fs_hz']:g} Hz, "
               f"{case['n_afferents']} afferents, {case['wall_s']:.1f} s; {case['label']}"),
              (f"ms after the raw event, model time; detected: the path's contact state (shear: its consumed "

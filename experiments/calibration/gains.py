@@ -1,6 +1,6 @@
 """Calibrate the current gains and report the derivative cut-off's effect.
 
-The gains g_sai, g_rai and g_raii of eqs 1-3 are fitted so that the CMM
+The gains of eqs 1-3 (each paper type's `TypeParams.gain`) are fitted so that the CMM
 (AF = 1) press-push-lift SF matches paper Table III's CMM column: 47.5, 15
 and 10 pulses/s for SAI, RAI and RAII.  Each type's CMM SF depends on its
 own gain only and rises with it, so each gain is a 1-D root (Brent's method
@@ -40,7 +40,6 @@ __all__ = ["CMM_TARGETS", "cmm_sf", "fit_gains", "cutoff_effect", "transducer_sc
 
 #: Paper Table III, CMM column (pulses/s).
 CMM_TARGETS = {t: PAPER_TABLE3["cmm"][t][0] for t in PAPER_TYPES}
-_GAIN_FIELD = {"SAI": "g_sai", "RAI": "g_rai", "RAII": "g_raii"}
 _BRACKETS = {"SAI": (0.5, 50.0), "RAI": (0.5, 1000.0), "RAII": (0.05, 10000.0)}
 
 
@@ -56,16 +55,14 @@ def cmm_sf(kind: str, params: CurrentParams, dt: float = 1e-4) -> float:
 
 def fit_gains(params: CurrentParams = CurrentParams(), targets=CMM_TARGETS) -> CurrentParams:
     """Fit each gain so the CMM SF of its type crosses the target (Brent's method)."""
-    fitted = {}
+    fitted = params
     for kind in PAPER_TYPES:
-        field = _GAIN_FIELD[kind]
-
-        def excess(g, kind=kind, field=field):
-            return cmm_sf(kind, dataclasses.replace(params, **{field: g})) - targets[kind]
+        def excess(g, kind=kind):
+            return cmm_sf(kind, params.with_type(kind, gain=g)) - targets[kind]
 
         lo, hi = _BRACKETS[kind]
-        fitted[field] = round(brentq(excess, lo, hi, rtol=1e-3), 3)
-    return dataclasses.replace(params, **fitted)
+        fitted = fitted.with_type(kind, gain=round(brentq(excess, lo, hi, rtol=1e-3), 3))
+    return fitted
 
 
 def cutoff_effect(params: CurrentParams, cutoffs=(10.0, 20.0, 40.0, 80.0)) -> dict:
@@ -116,7 +113,7 @@ def transducer_scan(settings=((None, 20.0), (100.0, 20.0), (50.0, 20.0), (50.0, 
                  for name, scene in (("birznieks", birznieks(90.0)), ("ppl", press_push_lift(90.0)))
                  for kind in PAPER_TYPES}
         rows.append({"i_sat": i_sat, "cutoff_hz": cutoff,
-                     "gains": {f: getattr(params, f) for f in ("g_sai", "g_rai", "g_raii")},
+                     "gains": {kind: params.gain(kind) for kind in PAPER_TYPES},
                      "checks": _table_checks(params), "peak_rate_10ms": peaks})
     return rows
 
@@ -130,7 +127,7 @@ def main(argv=None) -> int:
     params = fit_gains()
     achieved = {t: round(cmm_sf(t, params), 2) for t in PAPER_TYPES}
     report = {
-        "fitted": {f: getattr(params, f) for f in ("g_sai", "g_rai", "g_raii")},
+        "fitted": {kind: params.gain(kind) for kind in PAPER_TYPES},
         "cutoff_hz": params.cutoff_hz,
         "cmm_sf": achieved,
         "targets": CMM_TARGETS,

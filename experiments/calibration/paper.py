@@ -51,8 +51,7 @@ FIT_CELLS = (("II", "selective", "PRSI"), ("II", "broad", "PRSI")) \
     + (("III", "bipolar", "SF (75°)"), ("III", "cmm", "SF (75°)"))
 READINGS = ("pass", "block")
 DEFINITIONS = ("contact_mean", "peak_bin")
-_GAIN = {"SAI": "g_sai", "RAI": "g_rai", "RAII": "g_raii"}
-_CUTOFF = {"RAI": "cutoff_rai_hz", "RAII": "cutoff_raii_hz"}
+_CUTOFF = ("RAI", "RAII")  # the types whose cut-off is fitted
 _ORDER = {"SAI": 0, "RAI": 1, "RAII": 2}  # the derivative order: a ramp's drive scales as ramp_s ** -order
 # The unit box's axes: gain factor (log, 0.01-50 at the reference ramp), cut-off (Hz), ramp, lift (s),
 # shear onset (fraction of the push ramp), Birznieks shear onset (s).
@@ -74,12 +73,12 @@ def type_config(kind: str, u, reading: str, definition: str, base: ReproConfig =
     v = [lo + x * (hi - lo) for x, (lo, hi) in zip(u, box)]
     ramp = v[2]
     # the gain is scaled with the ramp so that one coordinate sets the ramp's drive whatever its length
-    gain = getattr(CurrentParams(), _GAIN[kind]) * math.exp(v[0]) * (ramp / _REFERENCE_RAMP_S) ** _ORDER[kind]
-    fields = {_GAIN[kind]: round(float(gain), 6)}
+    gain = CurrentParams().gain(kind) * math.exp(v[0]) * (ramp / _REFERENCE_RAMP_S) ** _ORDER[kind]
+    fields = {"gain": round(float(gain), 6)}
     if kind in _CUTOFF:
-        fields[_CUTOFF[kind]] = round(float(v[1]), 3)
+        fields["cutoff_hz"] = round(float(v[1]), 3)
     return dataclasses.replace(base, no_shear=reading, sf_definition=definition,
-                               current_params=dataclasses.replace(base.current_params, **fields),
+                               current_params=base.current_params.with_type(kind, **fields),
                                ramp_s=round(float(ramp), 4), lift_ramp_s=round(float(v[3]), 4),
                                shear_delay_s=round(float(v[4] * ramp), 4),
                                birznieks_shear_delay_s=round(float(v[5]), 4))
@@ -161,9 +160,8 @@ def calibrate_paper(*, seed: int = 0, n_random: int = 400, afferent_types=PAPER_
 
 def config_fields(config: ReproConfig, kind: str) -> dict:
     """The fitted fields of one type's `ReproConfig` (what `PAPER_CALIBRATION` states)."""
-    current = {_GAIN[kind]: getattr(config.current_params, _GAIN[kind])}
-    if kind in _CUTOFF:
-        current[_CUTOFF[kind]] = getattr(config.current_params, _CUTOFF[kind])
+    params = config.current_params.type_params(kind)
+    current = {"gain": params.gain, **({"cutoff_hz": params.cutoff_hz} if kind in _CUTOFF else {})}
     return {"no_shear": config.no_shear, "sf_definition": config.sf_definition, "ramp_s": config.ramp_s,
             "lift_ramp_s": config.lift_ramp_s, "shear_delay_s": config.shear_delay_s,
             "birznieks_shear_delay_s": config.birznieks_shear_delay_s, "current_params": current}

@@ -6,11 +6,11 @@ Fitted (per type, SA-I and FA-I, to Birznieks et al. 2001 as the paper reports i
 * by the untuned fraction (NAP ``none``), the bipolar share of tuned
   afferents and the broad share of tuned unipolar ones of each type, and
   for SA-I the transducer: **log compression**
-  ``i_sat_sai``, with ``g_sai`` tied so that an aligned afferent's drive at
+  ``SAI.i_sat``, with ``SAI.gain`` tied so that an aligned afferent's drive at
   4 N stays 18 mV/ms (about 40 pulses/s before adaptation).  Without
   compression the 5:1 AF ratio and the steep regular-spiking f-I curve give
   unipolar SA-I a DSI far above 0.23.
-* FA-I's gain ``g_rai`` is *fixed* at 6.35: tuning barely identifies it (the
+* FA-I's gain ``RAI.gain`` is *fixed* at 6.35: tuning barely identifies it (the
   DSI mean moves 0.249 -> 0.243 as the gain goes 4.5 -> 8), so Nelder-Mead
   wandered between runs (6.3 and 10.6); at 10.6 the transducer saturates at
   32 N/s and the first-spike code is lost (a held-out row then fails).
@@ -41,7 +41,7 @@ import json
 import numpy as np
 from scipy.optimize import minimize
 
-from ddmm.models.afferent_types import AFFERENT_TYPES
+from ddmm.models.afferent_types import afferent_type_codes, afferent_type_info
 from ddmm.population import load_spec, sample_population, simulate
 from ddmm.population.analysis.physiology import PROPERTIES, score_physiology
 from ddmm.population.analysis.tuning import DEFAULT_TRIALS, direction_tuning, tuning_scenes, tuning_summary
@@ -78,12 +78,12 @@ def apply_parameters(spec, kind: str, params: dict):
     nap = _nap(params["untuned"], params["bipolar"], params.get("broad", 0.5))
     tspec = dataclasses.replace(spec.types[kind], nap=nap)
     current = spec.current
-    if kind == "SAI":
+    if "i_sat" in params:  # SA-I's free parameter; FA-I's is its gain
         i_sat = params["i_sat"]
         gain = i_sat * np.expm1(_SAI_ON_CURRENT / i_sat) / 4.0
-        current = dataclasses.replace(current, g_sai=round(float(gain), 6), i_sat_sai=round(float(i_sat), 6))
+        current = current.with_type(kind, gain=round(float(gain), 6), i_sat=round(float(i_sat), 6))
     else:
-        current = dataclasses.replace(current, g_rai=round(float(params["gain"]), 6))
+        current = current.with_type(kind, gain=round(float(params["gain"]), 6))
     return spec.replace(types={**spec.types, kind: tspec}, current=current)
 
 
@@ -126,11 +126,13 @@ def _objective(theta, spec, kind, seeds):
 def _unpack(theta, kind, spec):
     shares = {"untuned": float(np.clip(theta[0], 0.0, 0.6)), "bipolar": float(np.clip(theta[1], 0.0, 0.9)),
               "broad": float(np.clip(theta[2], 0.0, 1.0))}
-    if kind == "SAI":
-        return {**shares, "i_sat": spec.current.i_sat_sai}
+    if kind in _FREE_I_SAT:
+        return {**shares, "i_sat": spec.current.type_params(kind).i_sat}
     return {**shares, "gain": RAI_GAIN}
 
 
+#: The types whose log-compression scale is free in the fit (the others' gain is fixed).
+_FREE_I_SAT = ("SAI",)
 #: FA-I's gain, fixed (see the module docstring), (mV/ms)/(N/s).
 RAI_GAIN = 6.35
 
@@ -151,8 +153,8 @@ def validate(spec, seeds=VALIDATION_SEEDS, scorecard: bool = True) -> dict:
     """Tuning statistics (and the scorecard) of the full spec on held-out seeds: per seed and mean +- SD."""
     runs = [type_statistics(spec, None, (seed,)) for seed in seeds]
     out = {"per_seed": runs, "mean_sd": {}, "scorecard_all_pass": {}}
-    keys = [("tuned_fraction", k) for k in ("all", "recorded") + AFFERENT_TYPES]
-    keys += [("dsi", k, m) for k in AFFERENT_TYPES for m in ("mean", "sd")]
+    keys = [("tuned_fraction", k) for k in ("all", "recorded") + afferent_type_codes()]
+    keys += [("dsi", k, m) for k in afferent_type_codes() for m in ("mean", "sd")]
     for key in keys:
         values = []
         for r in runs:
@@ -213,16 +215,26 @@ def _count_toml(t) -> list:
     return [] if t.density_per_cm2 is None else [f"density_per_cm2 = {t.density_per_cm2}"]
 
 
+def _current_toml(current) -> list:
+    """The [current] lines: its shared fields, then a [current.<TYPE>] table of each type's departures from the
+    type's registered defaults."""
+    lines = [f"{name} = {_toml_value(getattr(current, name))}" for name in ("cutoff_hz", "filter_order", "i_sat")
+             if getattr(current, name) is not None]
+    for kind, params in current.types:
+        default = afferent_type_info(kind).current
+        lines += ["", f"[current.{kind}]"]
+        lines += [f"{f.name} = {_toml_value(getattr(params, f.name))}" for f in dataclasses.fields(params)
+                  if getattr(params, f.name) != getattr(default, f.name) and getattr(params, f.name) is not None]
+    return lines
+
+
 def spec_to_toml(spec, header: str = "") -> str:
     """TOML text of a spec (the layout `ddmm.population.spec` reads)."""
     lines = [header.rstrip(), f"name = {_toml_value(spec.name)}", f"description = {_toml_value(spec.description)}",
              f"receptive_field = {_toml_value(spec.receptive_field)}", "", *_where_toml(spec), "", "[current]"]
     for kind, params in spec.neuron.items():
         lines[-1:-1] = [f"[neuron.{kind}]", *(f"{k} = {_toml_value(v)}" for k, v in dataclasses.asdict(params).items()), ""]
-    for f in dataclasses.fields(spec.current):
-        value = getattr(spec.current, f.name)
-        if value is not None:
-            lines.append(f"{f.name} = {_toml_value(value)}")
+    lines += _current_toml(spec.current)
     for kind, t in spec.types.items():
         lines += ["", f"[types.{kind}]", *_count_toml(t),
                   f"noise_sigma = {_toml_value(t.noise_sigma)}", f"noise_cv = {_toml_value(t.noise_cv)}",

@@ -33,13 +33,13 @@ __all__ = ["PAPER_CALIBRATION", "PAPER_OBJECTIVES", "GAINS_ONLY", "CALIBRATIONS"
 PAPER_CALIBRATION = {
     "SAI": ReproConfig(engine="direct", no_shear="pass", sf_definition="contact_mean", ramp_s=2.8, lift_ramp_s=4.9,
                        shear_delay_s=0.0, birznieks_shear_delay_s=0.0806,
-                       current_params=CurrentParams(g_sai=5.050402)),
+                       current_params=CurrentParams().with_type("SAI", gain=5.050402)),
     "RAI": ReproConfig(engine="direct", no_shear="block", sf_definition="peak_bin", ramp_s=3.5, lift_ramp_s=0.1,
                        shear_delay_s=1.1433, birznieks_shear_delay_s=0.05,
-                       current_params=CurrentParams(g_rai=0.256536, cutoff_rai_hz=201.667)),
+                       current_params=CurrentParams().with_type("RAI", gain=0.256536, cutoff_hz=201.667)),
     "RAII": ReproConfig(engine="direct", no_shear="block", sf_definition="contact_mean", ramp_s=0.2013,
                         lift_ramp_s=0.7, shear_delay_s=0.001, birznieks_shear_delay_s=0.05,
-                        current_params=CurrentParams(g_raii=0.49283, cutoff_raii_hz=29.242)),
+                        current_params=CurrentParams().with_type("RAII", gain=0.49283, cutoff_hz=29.242)),
 }
 #: The objective of each committed setting (`ddmm.experiments.calibration.paper.objective`), as the fit reported.
 PAPER_OBJECTIVES = {"SAI": 0.4109, "RAI": 0.0238, "RAII": 0.0982}

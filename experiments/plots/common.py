@@ -9,20 +9,28 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, PAPER_TYPES, afferent_type_info, type_label
+from ddmm.models.afferent_types import PAPER_TYPES, afferent_type_codes, afferent_type_info, type_label
 
-__all__ = ["TYPE_COLOURS", "plot_response", "plot_sf_vs_theta",
-           "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces",
-           "plot_dsi_histograms", "plot_preferred_rose", "plot_neurometric", "plot_pareto"]
+__all__ = ["TYPE_COLOURS",  # noqa: F822 (a view of the registry: the module's __getattr__)
+           "plot_response", "plot_sf_vs_theta", "plot_raster", "plot_psth", "plot_polar_counts", "plot_forces",
+           "plot_dsi_histograms", "plot_preferred_rose", "plot_neurometric", "plot_pareto", "type_colour"]
 
-#: The colour of each afferent type in every figure (`ddmm.models.afferent_types.AfferentType.colour`).
-TYPE_COLOURS = {code: afferent_type_info(code).colour for code in AFFERENT_TYPES}
+
+def type_colour(afferent_type: str) -> str:
+    """The colour of an afferent type in every figure (`ddmm.models.afferent_types.AfferentType.colour`)."""
+    return afferent_type_info(afferent_type).colour
+
+
+def __getattr__(name):
+    if name == "TYPE_COLOURS":  # a view of the registry, whatever is registered now
+        return {code: type_colour(code) for code in afferent_type_codes()}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def _present(types) -> list:
     """The afferent types present, in the package's order (at least one entry for an empty figure)."""
-    present = [k for k in AFFERENT_TYPES if np.any(np.asarray(types) == k)]
-    return present or [AFFERENT_TYPES[0]]
+    present = [k for k in afferent_type_codes() if np.any(np.asarray(types) == k)]
+    return present or [afferent_type_codes()[0]]
 
 
 def _plot_forces(ax, time, forces):
@@ -76,7 +84,7 @@ def plot_response(data: dict, *, title: str = "", bin_s: float | None = None) ->
         axes[1, col].set_ylabel("AF(t)")
         for row, kind in enumerate(kinds, start=2):
             _plot_spikes(axes[row, col], np.asarray(cond["spikes"][kind]), duration, bin_s,
-                         TYPE_COLOURS[kind], kind)
+                         type_colour(kind), kind)
         axes[-1, col].set_xlabel("time (s)")
     if title:
         fig.suptitle(title)
@@ -99,7 +107,7 @@ def plot_sf_vs_theta(sf: dict, *, title: str = "SF against tuning angle (Fig. 8)
         for kind in PAPER_TYPES:
             angles = np.array([float(a) for a in sf[profile][kind]])
             values = np.array(list(sf[profile][kind].values()), dtype=float)
-            ax.plot(angles, values, "o-", ms=3, color=TYPE_COLOURS[kind], label=type_label(kind))
+            ax.plot(angles, values, "o-", ms=3, color=type_colour(kind), label=type_label(kind))
         ax.axvline(90.0, color="grey", ls=":", lw=1)
         ax.set_title(profile)
         ax.set_xlabel("θ_T (deg)")
@@ -123,7 +131,8 @@ def plot_raster(ds, *, condition=0, trial=0, max_afferents: int = 2000) -> Figur
         Draw at most this many afferents (evenly subsampled per type).
     """
     types = ds.afferent_type.values
-    order = np.lexsort((ds.theta_t.values, [AFFERENT_TYPES.index(t) for t in types]))
+    codes = afferent_type_codes()
+    order = np.lexsort((ds.theta_t.values, [codes.index(t) for t in types]))
     if order.size > max_afferents:
         order = order[np.linspace(0, order.size - 1, max_afferents).astype(int)]
     row = np.full(ds.sizes["afferent"], -1)
@@ -133,14 +142,15 @@ def plot_raster(ds, *, condition=0, trial=0, max_afferents: int = 2000) -> Figur
     keep = row[aff] >= 0
     fig = Figure(figsize=(8.0, 6.0), layout="constrained")
     ax = fig.subplots()
-    colours = [TYPE_COLOURS[t] for t in types[aff[keep]]]
+    lut = {kind: type_colour(kind) for kind in set(types.tolist())}  # one registry lookup a type, not a spike
+    colours = [lut[t] for t in types[aff[keep]]]
     ax.scatter(ds.spike_time.values[sel][keep], row[aff[keep]], s=1.0, c=colours, marker="|", linewidths=0.5)
-    for kind in AFFERENT_TYPES:
+    for kind in afferent_type_codes():
         rows = row[(types == kind) & (row >= 0)]
         if rows.size:
             ax.axhline(rows.max() + 0.5, color="grey", lw=0.5)
             ax.text(1.01, rows.mean(), type_label(kind), transform=ax.get_yaxis_transform(), va="center",
-                    color=TYPE_COLOURS[kind])
+                    color=type_colour(kind))
     ax.set_xlim(0, float(ds.duration[condition]))
     ax.set_xlabel("time (s)")
     ax.set_ylabel("afferent (by type, then θ_T)")
@@ -161,8 +171,8 @@ def plot_psth(rates, forces=None) -> Figure:
 
     ``forces``, a simulation Dataset, adds its F_Z above the PSTH (per condition).
     """
-    groups = sorted(rates[rates.dims[1]].values, key=lambda g: (AFFERENT_TYPES.index(g) if g in AFFERENT_TYPES
-                                                                else len(AFFERENT_TYPES), str(g)))
+    codes = afferent_type_codes()
+    groups = sorted(rates[rates.dims[1]].values, key=lambda g: (codes.index(g) if g in codes else len(codes), str(g)))
     top = 1 if forces is not None else 0
     fig = Figure(figsize=(8.0, 2.2 * (len(groups) + top)), layout="constrained")
     axes = fig.subplots(len(groups) + top, 1, sharex=True, squeeze=False)[:, 0]
@@ -189,7 +199,7 @@ def plot_polar_counts(ds, *, condition=0) -> Figure:
     for i, kind in enumerate(kinds):
         ax = fig.add_subplot(1, len(kinds), i + 1, projection="polar")
         sel = ds.afferent_type.values == kind
-        ax.scatter(np.deg2rad(ds.theta_t.values[sel]), counts[sel], s=4, color=TYPE_COLOURS[kind])
+        ax.scatter(np.deg2rad(ds.theta_t.values[sel]), counts[sel], s=4, color=type_colour(kind))
         ax.yaxis.set_major_locator(MaxNLocator(3))  # a few radial ticks: they never run into each other
         ax.tick_params(axis="y", labelsize=7)
         ax.set_title(f"{type_label(kind)} (radius: spikes)")
@@ -218,7 +228,7 @@ def plot_dsi_histograms(tuning, reference: dict | None = None) -> Figure:
     for ax, kind in zip(axes, kinds):
         sel = (tuning.afferent_type.values == kind) & (tuning.responsive.values == 1)
         values = tuning.dsi.values[sel]
-        ax.hist(values, bins=np.linspace(0, 1, 21), color=TYPE_COLOURS[kind], alpha=0.7)
+        ax.hist(values, bins=np.linspace(0, 1, 21), color=type_colour(kind), alpha=0.7)
         if values.size:
             ax.axvline(values.mean(), color="k", lw=1.5, label=f"model {values.mean():.2f} ± {values.std():.2f}")
         if reference and kind in reference:
@@ -234,13 +244,13 @@ def plot_dsi_histograms(tuning, reference: dict | None = None) -> Figure:
 
 def plot_preferred_rose(tuning, bins: int = 16) -> Figure:
     """Rose plot of preferred directions of tuned afferents, per type (0 radial, 90 distal)."""
-    fig = Figure(figsize=(4.2 * len(AFFERENT_TYPES), 5.0), layout="constrained")
+    fig = Figure(figsize=(4.2 * len(afferent_type_codes()), 5.0), layout="constrained")
     edges = np.linspace(0, 2 * np.pi, bins + 1)
-    for i, kind in enumerate(AFFERENT_TYPES):
-        ax = fig.add_subplot(1, len(AFFERENT_TYPES), i + 1, projection="polar")
+    for i, kind in enumerate(afferent_type_codes()):
+        ax = fig.add_subplot(1, len(afferent_type_codes()), i + 1, projection="polar")
         sel = (tuning.afferent_type.values == kind) & (tuning.tuned.values == 1) & (tuning.has_preferred.values == 1)
         counts, _ = np.histogram(np.deg2rad(tuning.preferred_deg.values[sel]), edges)
-        ax.bar(edges[:-1], counts, width=edges[1] - edges[0], align="edge", color=TYPE_COLOURS[kind], alpha=0.7)
+        ax.bar(edges[:-1], counts, width=edges[1] - edges[0], align="edge", color=type_colour(kind), alpha=0.7)
         ax.set_xticks(np.deg2rad([0, 90, 180, 270]), ["radial", "distal", "ulnar", "proximal"], fontsize=8)
         ax.tick_params(axis="x", pad=2)
         ax.set_title(f"{type_label(kind)}: preferred directions of {int(sel.sum())} tuned\n(vector sum; axial ones "

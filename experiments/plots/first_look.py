@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ddmm.experiments.plots.common import TYPE_COLOURS
-from ddmm.models.afferent_types import AFFERENT_TYPES, type_label
+from ddmm.models.afferent_types import afferent_type_codes, type_label
 
 __all__ = ["ramp_and_hold_scene", "ramp_and_hold", "plot_ramp_and_hold"]
 
@@ -37,7 +37,7 @@ def ramp_and_hold(population, *, per_type: int = 8, trials: int = 10, seed: int 
     """Simulate ``per_type`` afferents of each type (the first of each) on `ramp_and_hold_scene`; a Dataset."""
     from ddmm.population import simulate
 
-    pick = np.concatenate([np.flatnonzero(population.afferent_type == kind)[:per_type] for kind in AFFERENT_TYPES])
+    pick = np.concatenate([np.flatnonzero(population.afferent_type == kind)[:per_type] for kind in afferent_type_codes()])
     return simulate(population.select(np.sort(pick)), ramp_and_hold_scene(force_n, rate_n_per_s), engine=engine,
                     seed=seed, trials=trials, quiet=True)
 
@@ -58,7 +58,7 @@ def _raster(ax, ds, kind, colour):
 
 def plot_ramp_and_hold(ds, bin_s: float = 0.02) -> Figure:
     """Force, then per type a raster (all trials) and a PSTH (mean over afferents and trials)."""
-    kinds = [k for k in AFFERENT_TYPES if np.any(ds.afferent_type.values == k)]
+    kinds = [k for k in afferent_type_codes() if np.any(ds.afferent_type.values == k)]
     fig = Figure(figsize=(7.5, 1.0 + 2.4 * len(kinds)), layout="constrained")
     axes = fig.subplots(1 + 2 * len(kinds), 1, sharex=True,
                         gridspec_kw={"height_ratios": [0.8] + [1.4, 0.8] * len(kinds)})

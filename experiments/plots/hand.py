@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from ddmm.experiments.plots.common import TYPE_COLOURS
-from ddmm.models.afferent_types import AFFERENT_TYPES, type_label
+from ddmm.experiments.plots.common import type_colour
+from ddmm.models.afferent_types import afferent_type_codes, type_label
 from ddmm.population.anatomy import hand_map
 
 __all__ = ["plot_hand", "hand_counts"]
@@ -84,11 +84,11 @@ def plot_hand(population, counts=None, ax=None) -> Figure:
     if counts is not None:
         ax.scatter(x[~active], y[~active], s=0.5, color="0.75", label=f"silent ({int((~active).sum())})")
         size = 1.0 + 40.0 * counts / max(counts.max(), 1e-12)
-    for kind in AFFERENT_TYPES:
+    for kind in afferent_type_codes():
         sel = (types == kind) & active
         silent = int(np.sum((types == kind) & ~active))
         if np.any(types == kind):  # the count is every afferent of the type, the silent ones named
-            ax.scatter(x[sel], y[sel], s=1.5 if counts is None else size[sel], color=TYPE_COLOURS[kind],
+            ax.scatter(x[sel], y[sel], s=1.5 if counts is None else size[sel], color=type_colour(kind),
                        alpha=0.6, lw=0, label=f"{type_label(kind)} ({int(np.sum(types == kind))}"
                                               + (f", {silent} silent)" if silent else ")"))
     ax.set_xlim(*_limits(x, y, region)[0])

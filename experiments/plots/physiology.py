@@ -6,7 +6,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ddmm.experiments.plots.common import TYPE_COLOURS, plot_dsi_histograms
-from ddmm.models.afferent_types import AFFERENT_TYPES, type_label
+from ddmm.models.afferent_types import afferent_type_codes, type_label
 from ddmm.population.analysis.physiology import FREQUENCIES_HZ
 
 __all__ = ["plot_rest", "plot_on_off", "plot_force_coding", "plot_frequency_tuning", "plot_timing",
@@ -18,7 +18,7 @@ def plot_rest(data: dict) -> Figure:
     """Resting rate of every afferent (60 s of zero force), by type."""
     fig = Figure(figsize=(6.0, 3.2), layout="constrained")
     ax = fig.add_subplot()
-    kinds = [k for k in AFFERENT_TYPES if np.any(data["type"] == k)]
+    kinds = [k for k in afferent_type_codes() if np.any(data["type"] == k)]
     for i, kind in enumerate(kinds):
         rate = data["rate"][data["type"] == kind]
         ax.scatter(np.full(rate.size, i) + np.linspace(-0.3, 0.3, rate.size), rate, s=4,
@@ -32,7 +32,7 @@ def plot_rest(data: dict) -> Figure:
 def plot_on_off(data: dict, bin_s: float = 0.02) -> Figure:
     """PSTH per type on the on/off protocol (0 -> 4 N at 10 N/s, 2 s hold, release), with the force."""
     ds = data["dataset"]
-    kinds = [k for k in AFFERENT_TYPES if np.any(ds.afferent_type.values == k)]
+    kinds = [k for k in afferent_type_codes() if np.any(ds.afferent_type.values == k)]
     fig = Figure(figsize=(7.0, 1.6 * (len(kinds) + 1)), layout="constrained")
     axes = fig.subplots(len(kinds) + 1, 1, sharex=True)
     axes[0].plot(ds.time.values, ds.fz.values[0], color="k")
@@ -110,7 +110,7 @@ def plot_cycle_histograms(data: dict, bins: int = 20) -> Figure:
     bins : int
         Bins per cycle.
     """
-    kinds = [k for k in AFFERENT_TYPES if k in data and "phases" in data[k]]
+    kinds = [k for k in afferent_type_codes() if k in data and "phases" in data[k]]
     fig = Figure(figsize=(3.2 * max(len(kinds), 1), 3.0), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, max(len(kinds), 1), squeeze=False)[0])
     edges = np.linspace(0.0, 1.0, bins + 1)
@@ -152,7 +152,7 @@ def plot_shear_magnitude(data: dict) -> Figure:
     types = np.asarray(data["type"]).astype(str)
     nap = np.asarray(data.get("nap", np.full(types.size, "selective"))).astype(str)
     unipolar = np.isin(nap, ("selective", "broad"))
-    kinds = [k for k in AFFERENT_TYPES if np.any(types == k)]
+    kinds = [k for k in afferent_type_codes() if np.any(types == k)]
     fig = Figure(figsize=(3.0 * max(len(kinds), 1), 3.0), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, max(len(kinds), 1), squeeze=False)[0])
     x, n = np.r_[0.0, MAGNITUDES_N], len(MAGNITUDES_N)

@@ -47,7 +47,7 @@ REF_DT = 5e-6
 def workload(population="fingertip", seed: int = 0, directions=DIRECTIONS, scene=birznieks):
     """The population with noise (and the trial excitability) off, and one scene per direction."""
     spec = load_spec(population)
-    steady = dataclasses.replace(spec.current, **{f"excite_cv_{t.lower()}": 0.0 for t in ("SAI", "RAI", "RAII", "SAII")})
+    steady = spec.current.with_all_types(excite_cv=0.0)
     quiet = spec.replace(types={k: dataclasses.replace(t, noise_sigma=0.0, noise_cv=0.0) for k, t in spec.types.items()},
                          current=steady)
     return sample_population(quiet, rng=seed), [scene(d) for d in directions]

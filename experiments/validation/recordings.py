@@ -52,6 +52,8 @@ PHASES = {
 }
 RATES_HZ = (100.0, 250.0, 1000.0, 5000.0)
 TYPES = ("SAI", "RAI", "RAII", "SAII")
+#: The slowest rate at which a type's rates are compared (FA-II's band needs 750 Hz: `AfferentType.fs_per_cutoff`).
+_MIN_FS_HZ = {"RAII": 750.0}
 
 
 def recording(profile: str, fs: float, noise_n: float, seed: int = 0) -> np.ndarray:
@@ -133,7 +135,7 @@ def _worst(rates) -> dict:
     for kind in TYPES:
         ratio = 1.0
         for phase in next(iter(rates.values()))[kind]:
-            values = [rates[fs][kind][phase] for fs in rates if kind != "RAII" or fs >= 750.0]
+            values = [rates[fs][kind][phase] for fs in rates if fs >= _MIN_FS_HZ.get(kind, 0.0)]
             if max(values) >= 2.0:
                 ratio = max(ratio, max(values) / max(min(values), 1e-9))
         worst[kind] = round(ratio, 3)

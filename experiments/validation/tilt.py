@@ -15,9 +15,9 @@ disc) of a seed the calibration never saw, with every force ramped together at 2
   4 N at 4, 20 and 32 N/s, and the median plateau rate (1.2-1.9 s), which should depend on the force and not
   on the loading rate.  Human SA-I reach 100-300 imp/s in fast loading (docs/references.md row 5).
 
-The scorecard holds the 4 N tilt (``tilt``: SA-I rows *constrained*, ``shear_sai`` and ``depth_sai`` were set
+The scorecard holds the 4 N tilt (``tilt``: SA-I rows *constrained*, ``SAI.shear`` and ``SAI.depth`` were set
 by hand to them; FA-I and SA-II *held out*) and the peaks at 30 N/s to 4 N (``peak_rate_SAI``, *constrained*:
-``transient_sai`` was set to it).  The 2 N tilt and the peaks at 4, 20 and 32 N/s here are in no fit or hand
+``SAI.transient`` was set to it).  The 2 N tilt and the peaks at 4, 20 and 32 N/s here are in no fit or hand
 setting: **held out**.  docs/validation.md, "Tilted loads", gives the numbers.
 """
 
@@ -29,6 +29,7 @@ import warnings
 
 import numpy as np
 
+from ddmm.models.afferent_types import is_type
 from ddmm.population.analysis.physiology_base import peak_rates, window_counts
 from ddmm.population.analysis.physiology_tilt import DIRECTIONS, TILT_DEG, tilt_scene
 from ddmm.population.analysis.physiology_tilt import tilt_table as _tilt_table
@@ -63,7 +64,7 @@ def tilt_table(population, normal_n: float = 4.0, tilt_deg: float = TILT_DEG, di
 def peak_table(population, forces_n=(2.0, 4.0), rates_n_s=LOADING_RATES, seed: int = 0) -> dict:
     """Median SA-I peak 1/ISI (imp/s) and plateau rate (imp/s) per target force and loading rate, over SA-I that
     fire at least three spikes."""
-    sai = np.flatnonzero(np.asarray(population.afferent_type) == "SAI")
+    sai = np.flatnonzero(is_type(population.afferent_type, "SAI"))
     table = {}
     for force in forces_n:
         for rate in rates_n_s:

@@ -210,14 +210,15 @@ def integrate(
     return run_checked(np.ascontiguousarray(current), substeps, dt, params, v, u, engine, method, r)
 
 
-def run_checked(current, substeps, dt, params, v, u, engine, method, r=None) -> SpikeResult:
+def run_checked(current, substeps, dt, params, v, u, engine, method, r=None, *, stacklevel=4) -> SpikeResult:
     """`integrate` on inputs already checked: the seam's engines, stability and spike checks.
 
     ``current`` is a finite, C-contiguous float64 (n_samples, n) array in
     mV/ms; ``params`` as `ddmm.models.neuron.neuron_arrays` gives them; ``v`` and
     ``u`` (mV) and ``r`` (refractory steps left; None: zeros) are updated in
     place to the final state.  For callers that made their inputs themselves
-    (`ddmm.models.fused.FusedPipeline.advance`).
+    (`Engine.advance`); ``stacklevel`` of the spike-cap warning counts from
+    the check (4: the caller of our caller).
     """
     n = current.shape[1]
     r = np.zeros(n) if r is None else r
@@ -228,7 +229,7 @@ def run_checked(current, substeps, dt, params, v, u, engine, method, r=None) -> 
     else:
         neuron, step = get_engine(engine).run(current, substeps, dt, params, v, u, r, method=method, v_peak=V_PEAK,
                                               v_floor=V_FLOOR)
-    check_integration(neuron, step, v, u, current, method, dt, stacklevel=4)  # the warning names our caller's caller
+    check_integration(neuron, step, v, u, current, method, dt, stacklevel=stacklevel)  # default: our caller's caller
     return SpikeResult(neuron, step, NeuronState(v, u, r), dt, current.shape[0] * substeps)
 
 

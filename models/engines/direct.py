@@ -26,18 +26,101 @@ from __future__ import annotations
 
 import math
 import os
+from typing import NamedTuple
 
 import numba as nb
 import numpy as np
 
-from ddmm.models.neuron import refractory_steps
+from ddmm.models.neuron import V_FLOOR, V_PEAK, refractory_steps
 from ddmm.utils.executors import shared_executor
 
-__all__ = ["run_direct", "default_threads", "BLOCK", "METHOD_CODES", "integrate_range", "integrate_parts", "part_bounds",
-           "spike_checks", "cap_scan"]
+__all__ = ["run_direct", "default_threads", "BLOCK", "METHOD_CODES", "NeuronTable", "Membrane", "neuron_table",
+           "integrate_range", "integrate_parts", "part_bounds", "spike_checks", "cap_scan"]
 
 BLOCK = 64  # neurons advanced together; 64 doubles of v and u stay in L1
 METHOD_CODES = {"euler": 0, "rk2": 1, "rk4": 2, "izhikevich2003": 3}
+
+
+class NeuronTable(NamedTuple):
+    """The integrator's constants for N neurons at one step and method (`neuron_table` builds it).
+
+    Attributes
+    ----------
+    substeps : int
+        Integration steps per current sample.
+    method : int
+        Scheme, a value of `METHOD_CODES`.
+    h : float
+        Step in ms (Brian2's dt/ms).
+    half : float
+        Half-step of the 2003 scheme in ms (Brian2's (0.5 dt)/ms).
+    a : ndarray
+        Recovery rate per neuron (1/ms).
+    b : ndarray
+        Sensitivity of u to v per neuron.
+    c : ndarray
+        Reset potential per neuron (mV).
+    d : ndarray
+        Reset increment of u per neuron (mV/ms).
+    nr : ndarray
+        Refractory steps per neuron (whole numbers as float64, `ddmm.models.neuron.refractory_steps`).
+    v_peak : float
+        Spike cut-off (mV).
+    v_floor : float
+        Lower bound on v after every step (mV).
+    block : int
+        Neurons advanced together (`BLOCK`).
+    """
+
+    substeps: int
+    method: int
+    h: float
+    half: float
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    d: np.ndarray
+    nr: np.ndarray
+    v_peak: float
+    v_floor: float
+    block: int
+
+
+class Membrane(NamedTuple):
+    """The state of N neurons, arrays of shape (n,) that the integrator updates in place.
+
+    Attributes
+    ----------
+    v : ndarray
+        Membrane potential (mV).
+    u : ndarray
+        Recovery variable (mV/ms).
+    r : ndarray
+        Refractory steps left (whole numbers as float64).
+    """
+
+    v: np.ndarray
+    u: np.ndarray
+    r: np.ndarray
+
+
+def neuron_table(params, substeps, dt, method, v_peak=V_PEAK, v_floor=V_FLOOR) -> NeuronTable:
+    """The `NeuronTable` of per-neuron ``params`` (``a``, ``b``, ``c``, ``d`` and optionally ``t_ref`` in s)
+    at step ``dt`` (s) with ``method`` (a name of `METHOD_CODES`), ``substeps`` steps per sample.
+
+    Examples
+    --------
+    >>> table = neuron_table({k: np.array([x]) for k, x in zip("abcd", (0.02, 0.2, -65.0, 8.0))}, 10, 1e-4, "rk4")
+    >>> table.method, round(table.h, 12), table.nr.tolist()
+    (2, 0.1, [0.0])
+    """
+    if method not in METHOD_CODES:  # validated at the seam; guard the kernel
+        raise ValueError(f"method={method!r} is not implemented by the direct engine")
+    h = 1.0 * dt / 0.001  # Brian2 computes dt/ms the same way
+    half = (1.0 * (0.5 * dt)) / 0.001  # and the Izhikevich half-step as (0.5 dt)/ms
+    nr = refractory_steps(params.get("t_ref", np.zeros(np.size(params["a"]))), dt)
+    return NeuronTable(substeps, METHOD_CODES[method], h, half, params["a"], params["b"], params["c"], params["d"], nr,
+                       v_peak, v_floor, BLOCK)
 
 
 def default_threads() -> int:
@@ -116,9 +199,8 @@ def _update(method, h, half, row, a, b, v, u):
 
 
 @nb.njit(cache=True, nogil=True)
-def _block(current, substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor, j0, k_start, idx, stp, n,
-           refractory):
-    """Advance one block (local arrays a..r, columns j0.. of ``current``) from sample k_start.
+def _block(current, table, mem, j0, k_start, idx, stp, n, refractory):
+    """Advance one block (``table``'s a..nr and ``mem`` local to it, columns j0.. of ``current``) from sample k_start.
 
     Each step: update (``method``), floor v at ``v_floor``, hold v at C while
     the refractory count ``r`` is positive (counting it down; only when
@@ -130,6 +212,8 @@ def _block(current, substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, 
     resumes.  Returns the sample to resume at (``n_samples`` when done) and
     the new fill level.
     """
+    substeps, method, h, half, a, b, c, d, nr, v_peak, v_floor, _ = table
+    v, u, r = mem
     n_samples = current.shape[0]
     m = v.size
     for k in range(k_start, n_samples):
@@ -200,13 +284,17 @@ def _double(buf, n):
 
 
 @nb.njit(cache=True, nogil=True)
-def integrate_range(current, substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor, block, lo, hi):
-    """Integrate neurons lo..hi (columns of the C-contiguous ``current``); return spikes.
+def integrate_range(current, table, mem, lo, hi):
+    """Integrate neurons lo..hi (columns of the C-contiguous ``current``) with the `NeuronTable` ``table``;
+    return spikes.
 
-    ``nr`` holds each neuron's refractory steps and ``r`` the steps it has
-    left (`ddmm.models.neuron.refractory_steps`), updated in place as
-    ``v`` and ``u``.
+    ``mem`` (`Membrane`) is updated in place: ``v``, ``u`` and ``r``, the
+    refractory steps each neuron has left (`ddmm.models.neuron.refractory_steps`).
+    Both may come as plain tuples (from Python: numba types them in C, a
+    named tuple in Python).
     """
+    substeps, method, h, half, a, b, c, d, nr, v_peak, v_floor, block = table
+    v, u, r = mem
     capacity = max(4096, 4 * block * substeps)
     idx, stp, n = np.empty(capacity, np.int64), np.empty(capacity, np.int64), 0
     for j0 in range(lo, hi, block):
@@ -218,10 +306,10 @@ def integrate_range(current, substeps, method, h, half, a, b, c, d, nr, v, u, r,
         for j in range(j1 - j0):
             if nrb[j] > 0.0 or rb[j] > 0.0:
                 refractory = True
+        local = NeuronTable(substeps, method, h, half, ab, bb, cb, db, nrb, v_peak, v_floor, block)
         k = 0
         while k < current.shape[0]:
-            k, n = _block(current, substeps, method, h, half, ab, bb, cb, db, nrb, vb, ub, rb, v_peak, v_floor, j0,
-                          k, idx, stp, n, refractory)
+            k, n = _block(current, local, Membrane(vb, ub, rb), j0, k, idx, stp, n, refractory)
             if k < current.shape[0]:  # buffers nearly full: double them and resume
                 idx, stp = _double(idx, n), _double(stp, n)
         v[j0:j1] = vb
@@ -231,7 +319,7 @@ def integrate_range(current, substeps, method, h, half, a, b, c, d, nr, v, u, r,
 
 
 @nb.njit(cache=True, nogil=True, parallel=True)
-def integrate_parts(current, substeps, method, h, half, a, b, c, d, nr, v, u, r, v_peak, v_floor, block, bounds):
+def integrate_parts(current, table, mem, bounds):
     """`integrate_range` on the column ranges ``bounds[p]..bounds[p+1]`` in parallel (numba threads).
 
     For a latency-bound caller (the streaming encoder's 1 ms chunk): one
@@ -239,12 +327,12 @@ def integrate_parts(current, substeps, method, h, half, a, b, c, d, nr, v, u, r,
     costs more than it saves.  Ranges on block boundaries give the spikes
     of the serial call, concatenated range by range.
     """
+    table, mem = NeuronTable(*table), Membrane(*mem)  # plain tuples from Python, named again
     n_parts = bounds.size - 1
     idx_parts = [np.empty(0, np.int64) for _ in range(n_parts)]
     stp_parts = [np.empty(0, np.int64) for _ in range(n_parts)]
     for p in nb.prange(n_parts):
-        idx_parts[p], stp_parts[p] = integrate_range(current, substeps, method, h, half, a, b, c, d, nr, v, u, r,
-                                                      v_peak, v_floor, block, bounds[p], bounds[p + 1])
+        idx_parts[p], stp_parts[p] = integrate_range(current, table, mem, bounds[p], bounds[p + 1])
     return _concatenate(idx_parts), _concatenate(stp_parts)
 
 
@@ -302,22 +390,16 @@ def run_direct(current, substeps, dt, params, v, u, r=None, method="euler", v_pe
     neuron, step : ndarray of int64
         One entry per spike, sorted by step then neuron.
     """
-    if method not in METHOD_CODES:  # validated at the seam; guard the kernel
-        raise ValueError(f"method={method!r} is not implemented by the direct engine")
-    h = 1.0 * dt / 0.001  # Brian2 computes dt/ms the same way
-    half = (1.0 * (0.5 * dt)) / 0.001  # and the Izhikevich half-step as (0.5 dt)/ms
     n_neurons = current.shape[1]
+    table = tuple(neuron_table(params, substeps, dt, method, v_peak, v_floor))  # plain tuples: typed in C
     threads = default_threads() if threads is None else threads
     bounds = part_bounds(n_neurons, threads)  # a neuron's block never depends on threads
-    args = [params[p] for p in ("a", "b", "c", "d")]
-    args.append(refractory_steps(params.get("t_ref", np.zeros(n_neurons)), dt))
-    r = np.zeros(n_neurons) if r is None else r
+    mem = (v, u, np.zeros(n_neurons) if r is None else r)
 
     # The whole C-contiguous array goes to every thread (a column slice would
     # be strided and defeat vectorisation); each thread owns a column range.
     def work(lo, hi):
-        return integrate_range(current, substeps, METHOD_CODES[method], h, half, *args, v, u, r, v_peak, v_floor,
-                                BLOCK, int(lo), int(hi))
+        return integrate_range(current, table, mem, int(lo), int(hi))
 
     ranges = list(zip(bounds[:-1], bounds[1:]))
     if len(ranges) == 1:

@@ -1,9 +1,11 @@
 """Engines as registered objects (as Brian2 registers its devices).
 
 An `Engine` knows everything a caller would otherwise decide by comparing
-engine names: how it integrates a block of neurons, how many afferents a
-block should hold, whether it runs the whole pipeline fused, how wide a
-streaming push runs, and what to import before worker threads start.
+engine names: how it integrates a block of neurons (`Engine.run`) and a
+chunk of the whole pipeline (`Engine.advance`: the direct engine fuses the
+pipeline's back pass with its integrator), how many afferents a block should
+hold, how wide a streaming push runs, and what to import before worker
+threads start.
 Callers look an engine up with `get_engine` (a name or an `Engine`) and ask
 it; they never compare names.
 
@@ -32,9 +34,6 @@ class Engine:
         Afferents per block when the blocks are Dask tasks.
     part_size : int or None
         A block larger than this runs in parts of this size (None: whole).
-    fused : bool
-        Whether the pipeline's currents and the neurons run in one pass
-        (`ddmm.models.fused.FusedPipeline.spikes`) instead of through `run`.
     summary : str
         One line on what the engine is, for help texts (``ddmm --engine``).
     """
@@ -44,7 +43,6 @@ class Engine:
     block_size: int = 4096
     task_block_size: int = 4096
     part_size: int | None = None
-    fused: bool = False
 
     def chunk_size(self, scheduler=None) -> int:
         """Afferents per block: `block_size` in process, `task_block_size` on a scheduler."""
@@ -66,12 +64,49 @@ class Engine:
         """
         raise NotImplementedError
 
+    def advance(self, pipeline, forces, state, sample0, key, neuron, *, dt, method, parts=1):
+        """One chunk of a `ddmm.models.fused.FusedPipeline` on this engine: (afferent, step, `NeuronState` after).
+
+        Parameters
+        ----------
+        pipeline : ddmm.models.fused.FusedPipeline
+        forces, state, sample0, key
+            As `FusedPipeline.advance` takes them (``state`` updated in place).
+        neuron : NeuronState or None
+            The state before the chunk (None: `FusedPipeline.initial_membrane`).
+        dt : float
+            Step in seconds.
+        method : str
+            Integration scheme.
+        parts : int
+            Column ranges the engine may integrate in parallel.
+
+        Returns
+        -------
+        afferent, step : ndarray of int64
+            The chunk's spikes (step counted from the chunk's start).
+        state : NeuronState
+
+        Notes
+        -----
+        This default computes the pipeline's currents and integrates them
+        with `run` through the seam's checks (`ddmm.models.engines.run_checked`);
+        an engine with an integrator of its own overrides it.
+        """
+        from ddmm.models.engines import run_checked, substeps_for  # the package imports this module
+
+        substeps, params = substeps_for(pipeline.fs, dt), pipeline.neuron_params()
+        v, u, r = pipeline.initial_membrane(neuron, key)
+        current = pipeline.currents(forces, state, sample0 > 0, sample0, key)
+        res = run_checked(current, substeps, dt, params, v, u, self, method, r, stacklevel=5)
+        return res.afferent, res.step, res.state
+
     def __repr__(self) -> str:
         return f"<ddmm engine {self.name!r}>"
 
 
 class DirectEngine(Engine):
-    """The numba integrator: small blocks that stay in cache, fused with the pipeline, threaded pushes."""
+    """The numba integrator: small blocks that stay in cache, fused with the pipeline's back pass, threaded pushes."""
 
     name = "direct"
     summary = "the numba integrator: the same spikes bit for bit, no C++ compile, usually faster"
@@ -81,7 +116,6 @@ class DirectEngine(Engine):
     #: A Dask task's block runs in parts of this size (as one part, the 100k case
     #: on 2 workers took 1.6 s against 0.93 s in process).
     part_size = 512
-    fused = True
     #: Afferents from which a streaming push integrates on every core: below, one core is faster.
     parallel_min_afferents = 4096
 
@@ -98,9 +132,17 @@ class DirectEngine(Engine):
 
         return run_direct(current, substeps, dt, params, v, u, r, method=method, v_peak=v_peak, v_floor=v_floor)
 
+    def advance(self, pipeline, forces, state, sample0, key, neuron, *, dt, method, parts=1):
+        """The pipeline's back pass and the neurons in one numba call (`ddmm.models.engines.direct_fused`),
+        ``parts`` column ranges in parallel."""
+        from .direct_fused import advance_fused
+
+        return advance_fused(pipeline, forces, state, sample0, key, neuron, dt=dt, method=method, parts=parts)
+
 
 class Brian2Engine(Engine):
-    """Brian2's C++ standalone device: large blocks, each a run of a compiled binary."""
+    """Brian2's C++ standalone device: large blocks, each a run of a compiled binary; a pipeline's chunk
+    integrates its currents (`Engine.advance`)."""
 
     name = "brian2"
     summary = "Brian2's C++ standalone device, compiled once per shape"

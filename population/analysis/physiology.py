@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models.afferent_types import AFFERENT_TYPES
+from ddmm.models.afferent_types import afferent_type_codes
 from ddmm.population.analysis import physiology_core as _core
 
 # Importable here, where protocol modules, figures and tests have always found them.
@@ -140,7 +140,7 @@ def _select(population, properties):
         needed = PROPERTIES[name].afferent_type
         if needed != "all" and not set(needed.split("+")) & present:
             raise ValueError(f"property {name!r} needs {needed} afferents; population {population.name!r} has "
-                             f"{', '.join(t for t in AFFERENT_TYPES if t in present)}")
+                             f"{', '.join(t for t in afferent_type_codes() if t in present)}")
     return names
 
 

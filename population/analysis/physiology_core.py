@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models.afferent_types import AFFERENT_TYPES
+from ddmm.models.afferent_types import afferent_type_codes, is_type
 from ddmm.models.attenuation import attenuation_factor
 from ddmm.population.analysis.physiology_base import _knots, _of, _p, _rates, _run
 from ddmm.population.stimuli.scenes import Scene, Stage, birznieks, press_push_lift, rotating_shear
@@ -134,7 +134,7 @@ def _max_rates(ds):
     dt = float(ds.attrs["dt"])
     capped = int(np.sum(isi < 1.5 * dt))
     out = {}
-    for kind in AFFERENT_TYPES:
+    for kind in afferent_type_codes():
         sel = _of(ds, kind)[owner]
         if _of(ds, kind).any():
             out[f"max_rate_{kind}"] = float(1.0 / isi[sel].min()) if np.any(sel) else 0.0
@@ -155,7 +155,7 @@ def _shipped_rates(population, context) -> dict:
 
 def _force_coding(population, context) -> dict:
     out, data = {}, {}
-    sa = population.select(population.afferent_type == "SAI")
+    sa = population.select(is_type(population.afferent_type, "SAI"))
     if len(sa):
         scenes = [_knots([0, 0.1, 0.1 + f / 2.0, 2.1 + f / 2.0], [0, 0, f, f], name=f"press_{f:g}N")
                   for f in (1.0, 2.0, 4.0)]
@@ -163,7 +163,7 @@ def _force_coding(population, context) -> dict:
         plateau = np.array([_rates(ds, 1.1 + f / 2.0, 2.1 + f / 2.0, c).mean() for c, f in enumerate((1.0, 2.0, 4.0))])
         out["force_coding_SAI"] = float(np.min(plateau[1:] / np.maximum(plateau[:-1], 1e-12)))
         data["sai_plateau"] = plateau
-    ra = population.select(population.afferent_type == "RAI")
+    ra = population.select(is_type(population.afferent_type, "RAI"))
     if len(ra):
         scenes = [_knots([0, 0.1, 0.1 + 4.0 / r, 0.4 + 4.0 / r], [0, 0, 4, 4], name=f"ramp_{r:g}") for r in (2, 8, 32)]
         ds = _run(ra, scenes, context)
@@ -311,7 +311,7 @@ def _timing(population, context) -> dict:
 
 def _jitter(population, context) -> dict:
     """Median over RA-I afferents of the SD of their first-spike time over 10 Birznieks trials (ms)."""
-    ra = population.select(population.afferent_type == "RAI")
+    ra = population.select(is_type(population.afferent_type, "RAI"))
     if not len(ra):
         return {}
     ds = _run(ra, [birznieks(90.0)], context, trials=10)
@@ -330,7 +330,7 @@ def _max_step(population, fs, no_shear):
     fy = np.cos(2 * np.pi * t / 0.4)  # 1 N distal, through zero at 0.1 s, proximal, back through 0.3 s
     fz = np.full_like(t, 2.0)
     worst = 0.0
-    tuned = np.flatnonzero((population.nap != "none") & (population.afferent_type != "SAII"))
+    tuned = np.flatnonzero((population.nap != "none") & (~is_type(population.afferent_type, "SAII")))
     for profile in np.unique(population.nap[tuned]):
         cols = tuned[population.nap[tuned] == profile][:200]
         af = attenuation_factor(np.zeros_like(t), fy, population.theta_t[cols], str(profile), population.k[cols],

@@ -16,14 +16,12 @@ response is the subject of the slowly adapting protocols.
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
 from ddmm.population.analysis.physiology import Property, _run, load_extensions
 from ddmm.population.stimuli.scenes import Contact, Scene, Stage
 
-__all__ = ["PROPERTIES", "PROTOCOLS", "RUNNERS", "FIELD_FORCES_N", "probe_scene", "field_radii"]
+__all__ = ["FIELD_FORCES_N", "PROPERTIES", "PROTOCOLS", "RUNNERS", "field_radii", "probe_scene"]
 
 #: Probe forces (N), each double the last.
 FIELD_FORCES_N = (0.4, 0.8, 1.6)
@@ -51,7 +49,7 @@ def field_radii(population, afferent_type: str, context) -> np.ndarray:
     """Radius (mm) of the responding field of ``afferent_type`` at each of `FIELD_FORCES_N` (0 where none responds)."""
     from ddmm.population.sampling import make_population
 
-    quiet = replace(population.current, **{f"excite_cv_{t.lower()}": 0.0 for t in ("SAI", "RAI", "RAII", "SAII")})
+    quiet = population.current.with_all_types(excite_cv=0.0)
     line = make_population([afferent_type] * _DISTANCES_MM.size, x_mm=_DISTANCES_MM, current=quiet,
                            name=f"{population.name}_probe_line", receptive_field=population.receptive_field)
     ds = _run(line, [probe_scene(f) for f in FIELD_FORCES_N], context, record=("spikes",))

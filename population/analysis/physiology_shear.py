@@ -131,10 +131,10 @@ def _shear(population, context) -> tuple:
         opp = _relative(sa, _of(ds, "SAI") & uni)[1]
         out.update(shear_pref_SAI=float(pref[-1]), shear_opp_SAI=float(opp[-1]),
                    shear_growth_SAI=float(np.diff(pref).min()), shear_fall_SAI=float(np.diff(opp).max()))
-    for kind in ("RAI", "RAII"):
+    for kind, grows in (("RAI", True), ("RAII", False)):  # FA-II code the ramp's corners, not its end value
         if _of(ds, kind).any():
             pref = _curves(fa, _of(ds, kind))[0]
-            if kind == "RAI":  # FA-II code the ramp's corners (transients), not its end value
+            if grows:
                 out[f"shear_growth_{kind}"] = float(np.diff(pref).min())
             both = _curves(fa, _of(ds, kind) & uni)
             out[f"shear_dir_{kind}"] = _ratio(both[0][-1], both[1][-1])

@@ -25,11 +25,19 @@ from __future__ import annotations
 
 import numpy as np
 
+from ddmm.models.afferent_types import is_type
 from ddmm.population.analysis import physiology as _ph
 from ddmm.population.stimuli.scenes import Scene, Stage
 
-__all__ = ["PROPERTIES", "PROTOCOLS", "RUNNERS", "vector_strength", "locking_at_threshold", "vibration_scene",
-           "vibration_rate_sai"]
+__all__ = [
+    "PROPERTIES",
+    "PROTOCOLS",
+    "RUNNERS",
+    "locking_at_threshold",
+    "vector_strength",
+    "vibration_rate_sai",
+    "vibration_scene",
+]
 
 
 def _rows(kind: str, band: str, variant: str) -> list:
@@ -153,7 +161,7 @@ def _phase_locking(population, context):
 
 def _vibration_sai(population, context):
     """SA-I mean rate over 0.5-1.5 s on a 1.5 N preload, with 0.3 N at 5 and 10 Hz over without."""
-    idx = np.flatnonzero(population.afferent_type == "SAI")
+    idx = np.flatnonzero(is_type(population.afferent_type, "SAI"))
     pick = np.random.default_rng(context["seed"]).choice(idx, min(idx.size, 40), replace=False)
     sub = population.select(np.sort(pick))
     fs, t1 = 1000.0, 1.5

@@ -33,7 +33,7 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, afferent_type_codes
+from ddmm.models.afferent_types import afferent_type_codes
 from ddmm.models.metrics import direction_index
 from ddmm.population.stimuli.scenes import birznieks
 from ddmm.utils.validation import check_dataset, check_real
@@ -180,7 +180,7 @@ def tuning_summary(tuning: xr.Dataset) -> dict:
     resp = tuning.responsive.values == 1
     types = tuning.afferent_type.values
     fractions, dsi, counts = {}, {}, {}
-    for kind in AFFERENT_TYPES:
+    for kind in afferent_type_codes():
         sel = resp & (types == kind)
         counts[kind] = int(sel.sum())
         if not sel.any():

@@ -42,21 +42,36 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ddmm.models.afferent_types import afferent_type_codes, afferent_type_info
 from ddmm.utils.deprecation import renamed_keyword
 from ddmm.utils.validation import as_float_array, check_count, check_instance, check_real, check_rng, shown
 
-__all__ = ["Ellipse", "Polygon", "HandRegion", "KINDS", "TYPES", "DENSITY_PER_CM2", "TYPE_SHARE",
+# TYPES and TYPE_SHARE are views of the registry (the module's __getattr__).
+__all__ = ["Ellipse", "Polygon", "HandRegion", "KINDS", "TYPES", "DENSITY_PER_CM2", "TYPE_SHARE",  # noqa: F822
            "REGIONS", "region_names", "get_region", "region_at", "sample_in_region", "region_counts",
            "region_table", "outline"]
 
 #: Region kinds, each with its own density.
 KINDS = ("fingertip", "finger", "palm")
-#: Afferent types in the package's order (``ddmm.models.afferent_types.AFFERENT_TYPES``).
-TYPES = ("SAI", "RAI", "RAII", "SAII")
 #: Afferents per cm², all types (docs/references.md row 16): fingertip and palm read (V), finger = palm x 1.6.
 DENSITY_PER_CM2 = {"fingertip": 241.0, "finger": 58.0 * 1.6, "palm": 58.0}
-#: Share of each type, the fingertip's (row 16, R): SA-I 70, FA-I 141, FA-II 21, SA-II 9 of 241.
-TYPE_SHARE = {"SAI": 70.0 / 241.0, "RAI": 141.0 / 241.0, "RAII": 21.0 / 241.0, "SAII": 9.0 / 241.0}
+
+
+def _shares() -> dict:
+    """Each mapped type's share of a region's afferents (`AfferentType.density_share`; the fingertip's, row 16:
+    SA-I 70, FA-I 141, FA-II 21, SA-II 9 of 241), in registration order."""
+    return {code: afferent_type_info(code).density_share
+            for code in afferent_type_codes(lambda kind: kind.density_share is not None)}
+
+
+def __getattr__(name):
+    # Views of the registry, whatever is registered now: the types on the map, in the package's order, and their
+    # shares.
+    if name == "TYPES":
+        return tuple(_shares())
+    if name == "TYPE_SHARE":
+        return _shares()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def _rotation(deg: float) -> np.ndarray:
@@ -389,7 +404,7 @@ def _largest_remainder(total: int, shares: dict) -> dict:
 
 
 @renamed_keyword("types", "afferent_types")
-def region_counts(afferent_types=TYPES, regions=None) -> dict:
+def region_counts(afferent_types=None, regions=None) -> dict:
     """Afferents per region and type: {region: {type: count}}.
 
     The region total is ``DENSITY_PER_CM2[kind] x area`` rounded to the
@@ -399,8 +414,9 @@ def region_counts(afferent_types=TYPES, regions=None) -> dict:
 
     Parameters
     ----------
-    afferent_types : sequence of str
-        Afferent types to keep, in any order (returned in `TYPES` order).
+    afferent_types : sequence of str or None
+        Afferent types to keep, in any order (returned in `TYPES` order;
+        None: every type on the map).
     regions : sequence of str or None
         Regions to count (default: all, in map order).
 
@@ -409,19 +425,21 @@ def region_counts(afferent_types=TYPES, regions=None) -> dict:
     >>> region_counts(regions=["D2d"])
     {'D2d': {'SAI': 238, 'RAI': 479, 'RAII': 71, 'SAII': 30}}
     """
+    shares = _shares()
+    afferent_types = tuple(shares) if afferent_types is None else afferent_types
     for name, value in (("afferent_types", afferent_types), ("regions", () if regions is None else regions)):
         if not hasattr(value, "__iter__"):  # a str is refused below, with the names allowed
             raise TypeError(f"{name} must be a sequence of names, got {type(value).__name__}")
-    bad = [t for t in afferent_types if t not in TYPES]
+    bad = [t for t in afferent_types if t not in shares]
     if bad or isinstance(afferent_types, str):
-        raise ValueError(f"afferent_types={afferent_types!r}: allowed afferent_types are {', '.join(TYPES)}")
+        raise ValueError(f"afferent_types={afferent_types!r}: allowed afferent_types are {', '.join(shares)}")
     names = region_names() if regions is None else tuple(get_region(r).name for r in regions)
     out = {}
     for name in names:
         region = REGIONS[name]
         total = int(np.floor(DENSITY_PER_CM2[region.kind] * region.area_mm2 / 100.0 + 0.5))
-        counts = _largest_remainder(total, TYPE_SHARE)
-        out[name] = {t: counts[t] for t in TYPES if t in afferent_types}
+        counts = _largest_remainder(total, shares)
+        out[name] = {t: counts[t] for t in shares if t in afferent_types}
     return out
 
 

@@ -46,19 +46,28 @@ from __future__ import annotations
 
 import numpy as np
 
-from ddmm.models.afferent_types import AFFERENT_TYPES
+from ddmm.models.afferent_types import afferent_type_codes, afferent_type_info
 from ddmm.population.stimuli.scenes import Contact, Sites
 from ddmm.utils.validation import as_finite_array, check_instance
 
-__all__ = ["RF_AREA_MM2", "RF_SIGMA_MM", "RF_SUPPORT", "RF_SHAPES", "RF_TAIL_FLOOR", "REFERENCE_AREA_MM2",
-           "receptive_field_weight", "population_weight", "site_weights", "local_mixing", "site_coverage", "frame_theta"]
+# RF_AREA_MM2 and RF_SIGMA_MM are views of the registry (the module's __getattr__).
+__all__ = ["RF_AREA_MM2", "RF_SIGMA_MM", "RF_SUPPORT", "RF_SHAPES", "RF_TAIL_FLOOR", "REFERENCE_AREA_MM2",  # noqa: F822
+           "receptive_field_weight", "population_weight", "site_weights", "local_mixing", "site_coverage",
+           "frame_theta"]
 
-#: Median receptive-field area per type in mm^2 (docs/references.md row 17: SA-I, FA-I read (V); SA-II about
-#: 5x and FA-II about 10x larger, read in a secondary source (V2)).
-RF_AREA_MM2 = {"SAI": 11.0, "RAI": 12.6, "SAII": 5 * 11.0, "RAII": 10 * 12.6}
-#: Gaussian fall-off width per type (mm): a point probe gets weight >= 1/2 within sigma * sqrt(2 ln 2),
-#: a disc whose area is the type's median field.
-RF_SIGMA_MM = {kind: float(np.sqrt(area / np.pi) / np.sqrt(2.0 * np.log(2.0))) for kind, area in RF_AREA_MM2.items()}
+
+
+def __getattr__(name):
+    # Views of the registry, whatever is registered now: each type's median receptive-field area in mm^2
+    # (`AfferentType.rf_area_mm2`; docs/references.md row 17: SA-I, FA-I read (V); SA-II about 5x and FA-II about
+    # 10x larger, read in a secondary source (V2)) and its Gaussian fall-off width in mm (`AfferentType.rf_sigma_mm`:
+    # a point probe gets weight >= 1/2 within sigma * sqrt(2 ln 2), a disc whose area is the type's median field).
+    if name == "RF_AREA_MM2":
+        return {code: afferent_type_info(code).rf_area_mm2 for code in afferent_type_codes()}
+    if name == "RF_SIGMA_MM":
+        return {code: afferent_type_info(code).rf_sigma_mm for code in afferent_type_codes()}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 #: The contact area the model's forces refer to, mm^2: a fingertip pad under a flat surface at 2-4 N,
 #: a disc of 6 mm radius (recalled, not read in a stored source: R).
 REFERENCE_AREA_MM2 = float(np.pi * 6.0 ** 2)
@@ -112,7 +121,7 @@ def receptive_field_weight(x_mm, y_mm, afferent_type, contact, shape: str = "gau
     Examples
     --------
     >>> from ddmm.population.stimuli.scenes import Contact
-    >>> x = [0.0, 1.0 + RF_SIGMA_MM["SAI"], 9.0]
+    >>> x = [0.0, 1.0 + afferent_type_info("SAI").rf_sigma_mm, 9.0]
     >>> receptive_field_weight(x, [0.0] * 3, ["SAI"] * 3, Contact(0.0, 0.0, 1.0)).round(3).tolist()
     [1.0, 0.607, 0.0]
     >>> receptive_field_weight(x, [0.0] * 3, ["SAI"] * 3, Contact(0.0, 0.0, 1.0), "tailed").round(3).tolist()
@@ -134,11 +143,11 @@ def _afferents(x_mm, y_mm, afferent_type) -> tuple:
         raise ValueError(f"x_mm, y_mm and afferent_type must have one entry per afferent each, got shapes "
                          f"{x.shape}, {y.shape} and {types.shape}") from None
     sigma = np.full(x.shape, np.nan)
-    for kind in AFFERENT_TYPES:
-        sigma[types == kind] = RF_SIGMA_MM[kind]
+    for kind in afferent_type_codes():
+        sigma[types == kind] = afferent_type_info(kind).rf_sigma_mm
     if np.isnan(sigma).any():
         bad = types[np.isnan(sigma)].flat[0]
-        raise ValueError(f"afferent_type={bad!r} is unknown; allowed: {', '.join(AFFERENT_TYPES)}")
+        raise ValueError(f"afferent_type={bad!r} is unknown; allowed: {', '.join(afferent_type_codes())}")
     return sigma, x, y
 
 

@@ -108,8 +108,8 @@ def _tilt_reference(R) -> dict:
            "the normal load, against it the load subtracts")
     most, variant = ": most units rise in some direction (R: a broad range)", "; a variant: 2 N tilted 30 deg, 8 directions"
     return {
-        "tilt_above_SAI": R(0.5, 1.0, src + most + "; shear_sai and depth_sai set by hand to it", "constrained", "R"),
-        "tilt_silenced_SAI": R(0.0, 0.2, src + ": it lowers, seldom silences (R); shear_sai and depth_sai set by "
+        "tilt_above_SAI": R(0.5, 1.0, src + most + "; SAI.shear and SAI.depth set by hand to it", "constrained", "R"),
+        "tilt_silenced_SAI": R(0.0, 0.2, src + ": it lowers, seldom silences (R); SAI.shear and SAI.depth set by "
                                "hand to it", "constrained", "R"),
         "tilt_above_RAI": R(0.5, 1.0, src + most, "held out", "R"),
         "tilt_above_SAII": R(0.5, 1.0, src + most, "held out", "R"),
@@ -127,7 +127,7 @@ def _everyday_reference(R) -> dict:
     rate = ("docs/references.md rows 28, 29: thresholds spread over an order of magnitude within a type, so "
             "recruitment grows gradually with loading rate; FA-I respond to the slow loading of manipulation")
     spread = "docs/references.md row 28: thresholds of one type differ by an order of magnitude or more"
-    chosen = "; threshold_rai set by hand to it"
+    chosen = "; RAI.threshold set by hand to it"
     return {
         "release_2Ns_RAI": R(0.05, 1.0, off, "held out", "R"),
         "release_4Ns_RAI": R(0.5, 1.0, off + chosen, "constrained", "R"),
@@ -154,8 +154,8 @@ def _vibration_reference(R) -> dict:
     `ddmm.population.analysis.physiology_vibration`).
 
     Row 21 is recalled (R): "VS typically > 0.8 at 1:1", so the ranges are
-    broad.  The 1 N rows at 10-60 Hz are ``constrained``: ``tau_rai_s``,
-    ``i_max_rai`` and ``negative_weight_rai`` of the presets were chosen on
+    broad.  The 1 N rows at 10-60 Hz are ``constrained``: ``RAI.tau_s``,
+    ``RAI.i_max`` and ``RAI.negative_weight`` of the presets were chosen on
     them, and FA-II's ``t_ref``, drive and smoothing on its 1 N rows at
     100-250 Hz.  The 2 N variants (15 and 45 Hz; 125 and 175 Hz) are ``held
     out``.
@@ -191,16 +191,16 @@ def _variability_reference(R) -> dict:
     20 presses to 2 N (`ddmm.population.analysis.physiology_variability`).
     Row 23 (R) gives Fano factors of roughly 0.1-1 and row 14 (R) a jitter of
     a few ms, the broad range of the core ``jitter_RAI`` row.  The trial
-    excitability CVs (``excite_cv_<type>``) were set by hand on the SA-I and
+    excitability CVs (``<TYPE>.excite_cv``) were set by hand on the SA-I and
     FA-II Fano rows (constrained); the FA-I Fano row and every jitter row
     are held out.
     """
     fano = "docs/references.md row 23: Fano factors of roughly 0.1-1 in the dynamic phase (R: a broad range)"
     jitter = "docs/references.md rows 14, 23: first-spike jitter of a few ms (R: a broad range)"
     return {
-        "fano_SAI": R(0.1, 1.0, fano + "; excite_cv_sai set by hand to it", "constrained", "R"),
+        "fano_SAI": R(0.1, 1.0, fano + "; SAI.excite_cv set by hand to it", "constrained", "R"),
         "fano_RAI": R(0.1, 1.0, fano, "held out", "R"),
-        "fano_RAII": R(0.1, 1.0, fano + "; excite_cv_raii set by hand to it", "constrained", "R"),
+        "fano_RAII": R(0.1, 1.0, fano + "; RAII.excite_cv set by hand to it", "constrained", "R"),
         "first_jitter_SAI": R(0.5, 10.0, jitter, "held out", "R"),
         "first_jitter_RAI": R(0.5, 10.0, jitter, "held out", "R"),
         "first_jitter_RAII": R(0.5, 10.0, jitter, "held out", "R"),
@@ -213,13 +213,13 @@ def _shear_reference(R) -> dict:
     src = "docs/references.md rows 18, 22: every type responds to tangential force, rising with its magnitude in the "
     pref, shape = src + "preferred direction", " (shape only, R: a broad range)"
     return {
-        "shear_pref_SAI": R(1.1, inf, pref + "; shear_sai set by hand to it", "constrained", "R"),
+        "shear_pref_SAI": R(1.1, inf, pref + "; SAI.shear set by hand to it", "constrained", "R"),
         "shear_opp_SAI": R(0.0, 0.9, src + "opposite direction lowering the rate" + shape, "held out", "R"),
         "shear_growth_SAI": R(0.01, inf, pref + ": monotonic growth" + shape, "held out", "R"),
         "shear_fall_SAI": R(-inf, 0.0, src + "opposite direction: no rise with magnitude" + shape, "held out", "R"),
         "shear_growth_RAI": R(0.01, inf, pref + ": FA-I ramp responses grow" + shape, "held out", "R"),
         "shear_dir_RAI": R(1.0, inf, pref + ": FA-I respond more in it than against it" + shape, "held out", "R"),
-        "shear_ramp_RAI": R(0.5, 1.0, src + "FA-I fire during a tangential ramp; shear_rai set by hand to it",
+        "shear_ramp_RAI": R(0.5, 1.0, src + "FA-I fire during a tangential ramp; RAI.shear set by hand to it",
                             "constrained", "R"),
         "shear_dir_RAII": R(1.0, inf, pref + ": FA-II respond more in it than against it" + shape, "held out", "R"),
         "shear_growth_SAII": R(0.01, inf, pref + ": SA-II rates grow with stretch" + shape, "held out", "R"),
@@ -239,18 +239,18 @@ def _slow_reference(R) -> dict:
              "neither vanishes nor is complete (R: a broad range)")
     peak = "docs/references.md row 5: SA-I peak 100-300 imp/s in fast loading against 10-60 in the plateau"
     return {
-        "rest_spread_SAII": R(4.0, 15.0, rest + "; bias_cv_saii set by hand to it", "constrained", "R"),
+        "rest_spread_SAII": R(4.0, 15.0, rest + "; SAII.bias_cv set by hand to it", "constrained", "R"),
         "rest_active_SAII": R(0.5, 1.0, rest + ": most SA-II fire at rest", "held out", "R"),
         "start_synchrony_SAII": R(0.0, 0.5, "docs/references.md row 24: units fire independently (each its own "
                                   "rate and phase); 1 = every unit in step", "held out", "R"),
         "normal_coding_SAII": R(1.05, inf, "docs/references.md rows 12, 24: every nail-border SA-II responded to "
                                 "4 N normal forces (rates rise with normal force)", "held out", "V"),
-        "adaptation_05N_SAI": R(0.1, 0.75, adapt + "; dynamic_sai set by hand to it", "constrained", "V"),
+        "adaptation_05N_SAI": R(0.1, 0.75, adapt + "; SAI.dynamic set by hand to it", "constrained", "V"),
         "adaptation_2N_SAI": R(0.1, 0.75, adapt, "held out", "V"),
-        "adaptation_8N_SAI": R(0.1, 0.75, adapt + "; dynamic_sai set by hand to it", "constrained", "V"),
-        "peak_plateau_SAI": R(1.5, inf, peak + "; dynamic_sai set by hand to it", "constrained", "R"),
+        "adaptation_8N_SAI": R(0.1, 0.75, adapt + "; SAI.dynamic set by hand to it", "constrained", "V"),
+        "peak_plateau_SAI": R(1.5, inf, peak + "; SAI.dynamic set by hand to it", "constrained", "R"),
         "peak_plateau_2N_SAI": R(1.5, inf, peak + " (a variant: 20 N/s to 2 N)", "held out", "R"),
-        "peak_rate_SAI": R(100.0, 300.0, peak + "; transient_sai set by hand to it", "constrained", "R"),
+        "peak_rate_SAI": R(100.0, 300.0, peak + "; SAI.transient set by hand to it", "constrained", "R"),
         "peak_rate_2N_SAI": R(100.0, 300.0, peak + " (a variant: 20 N/s to 2 N)", "held out", "R"),
         "plateau_rate_SAI": R(0.8, 1.25, "docs/references.md rows 5, 6: the SA-I plateau codes the force, not how "
                               "fast it was reached (R: within 20%)", "held out", "R"),

@@ -22,6 +22,7 @@ the same spikes and forces give the same pulses, bit for bit.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numba as nb
 import numpy as np
@@ -97,6 +98,83 @@ def _csr(lists, n_items: int):
     return indptr, members, np.cumsum(back_ptr), owners[order]
 
 
+class _Wiring(NamedTuple):
+    """The fixed tables of one `PulseKernel`: which afferents feed which field, the limits, the rule.
+
+    Attributes
+    ----------
+    weights : ndarray, shape (n_afferents,)
+        Each afferent's spike weight.
+    indptr, members : ndarray of int64
+        CSR of the afferent positions of each electrode's field (``indptr`` (n_electrodes + 1,)).
+    back_ptr, back : ndarray of int64
+        The reverse CSR: the electrodes each afferent feeds (``back_ptr`` (n_afferents + 1,)).
+    limits : ndarray, shape (n_electrodes, 4)
+        Per electrode: amplitude_min_ua, amplitude_max_ua, max_rate_hz, phase_width_us.
+    params : ndarray
+        The rule's parameters (`rules`' ``params()``).
+    code : int
+        The rule's code (0 biomimetic, 1 linear amplitude, 2 linear frequency).
+    contact : float
+        The contact threshold on the force under a field, N.
+    fs : float
+        Model sample rate, Hz.
+    """
+
+    weights: np.ndarray
+    indptr: np.ndarray
+    members: np.ndarray
+    back_ptr: np.ndarray
+    back: np.ndarray
+    limits: np.ndarray
+    params: np.ndarray
+    code: int
+    contact: float
+    fs: float
+
+
+class _KernelState(NamedTuple):
+    """The state a `PulseKernel` carries between calls (arrays, updated in place).
+
+    Attributes
+    ----------
+    rate : ndarray, shape (n_electrodes,)
+        Smoothed aggregate spike rate per electrode, Hz.
+    phase : ndarray, shape (n_electrodes,)
+        Phase accumulator per electrode (a pulse starts where it crosses 1).
+    last_pulse : ndarray, shape (n_electrodes,)
+        Time of each electrode's last pulse, s (-inf: none yet).
+    last_spike : ndarray of int64, shape (n_afferents,)
+        Model sample of each afferent's last spike.
+    """
+
+    rate: np.ndarray
+    phase: np.ndarray
+    last_pulse: np.ndarray
+    last_spike: np.ndarray
+
+
+class _PulseBuffers(NamedTuple):
+    """The buffers one `PulseKernel.advance` fills (the pulses up to the count the kernel returns).
+
+    Attributes
+    ----------
+    time : ndarray, shape (n_max,)
+        Pulse start times, s.
+    electrode : ndarray of int64, shape (n_max,)
+        Pulse electrodes (positions in the table).
+    amplitude : ndarray, shape (n_max,)
+        Pulse amplitudes, uA.
+    traces : ndarray, shape (3, n, n_electrodes)
+        Rate command (Hz), amplitude command (uA) and aggregate rate (Hz) per sample.
+    """
+
+    time: np.ndarray
+    electrode: np.ndarray
+    amplitude: np.ndarray
+    traces: np.ndarray
+
+
 class PulseKernel:
     """The pulse generator of one electrode table on one set of afferents (state: real, carried between calls).
 
@@ -124,14 +202,15 @@ class PulseKernel:
         self._limits = np.stack([table.column("amplitude_min_ua"), table.column("amplitude_max_ua"),
                                  table.column("max_rate_hz"), table.column("phase_width_us")], axis=1)
         self._params = rule.params()
+        self._wiring = _Wiring(self._weights, self._indptr, self._members, self._back_ptr, self._back, self._limits,
+                              self._params, int(self.rule.code), CONTACT_THRESHOLD, self.fs)
         self.reset()
 
     def reset(self) -> None:
         """Back to the start: no rate, no phase, no pulse yet, no spike seen."""
         n_e = len(self.table)
-        self._rate, self._phase = np.zeros(n_e), np.zeros(n_e)
-        self._last_pulse = np.full(n_e, -np.inf)
-        self._last_spike = np.full(self._weights.size, np.iinfo(np.int64).min // 2, np.int64)
+        self._state = _KernelState(np.zeros(n_e), np.zeros(n_e), np.full(n_e, -np.inf),
+                                   np.full(self._weights.size, np.iinfo(np.int64).min // 2, np.int64))
         self._k = 0
 
     def advance(self, field_force, spike_sample, spike_afferent):
@@ -145,15 +224,12 @@ class PulseKernel:
         force = np.ascontiguousarray(field_force, dtype=float)
         n = force.shape[0]
         n_max = int(n * len(self.table) * (math.ceil(float(self._limits[:, 2].max()) / self.fs) + 1))
-        out_t, out_e, out_a = np.empty(n_max), np.empty(n_max, np.int64), np.empty(n_max)
-        traces = np.zeros((3, n, len(self.table)))
-        count = _advance(self._k, force, self.fs, np.ascontiguousarray(spike_sample, np.int64),
-                         np.ascontiguousarray(spike_afferent, np.int64), self._weights, self._indptr, self._members,
-                         self._back_ptr, self._back, self._limits, self._params, int(self.rule.code),
-                         CONTACT_THRESHOLD, self._rate, self._phase, self._last_pulse, self._last_spike,
-                         out_t, out_e, out_a, traces)
+        out = _PulseBuffers(np.empty(n_max), np.empty(n_max, np.int64), np.empty(n_max),
+                            np.zeros((3, n, len(self.table))))
+        count = _advance(self._k, force, np.ascontiguousarray(spike_sample, np.int64),
+                         np.ascontiguousarray(spike_afferent, np.int64), self._wiring, self._state, out)
         self._k += n
-        return (out_t[:count], out_e[:count], out_a[:count]), traces
+        return (out.time[:count], out.electrode[:count], out.amplitude[:count]), out.traces
 
 
 @nb.njit(cache=True)
@@ -178,8 +254,13 @@ def _between(a_min, a_max, x):
 
 
 @nb.njit(cache=True)
-def _pulses(e, t0, t1, f, amp, phase, last_pulse, min_interval, out_t, out_e, out_a, count):
-    """Place the pulses of electrode ``e`` in [t0, t1) at rate ``f``; returns the new count."""
+def _pulses(e, t0, t1, f, amp, min_interval, state, out, count):
+    """Place the pulses of electrode ``e`` in [t0, t1) at rate ``f``; returns the new count.
+
+    ``state`` (`_KernelState`: its ``phase`` and ``last_pulse``) is updated; the pulses go to ``out``
+    (`_PulseBuffers`) from position ``count`` on.
+    """
+    phase, last_pulse, out_t, out_e, out_a = state.phase, state.last_pulse, out.time, out.electrode, out.amplitude
     t = t0
     while f > 0.0:
         need = (1.0 - phase[e]) / f
@@ -196,8 +277,13 @@ def _pulses(e, t0, t1, f, amp, phase, last_pulse, min_interval, out_t, out_e, ou
 
 
 @nb.njit(cache=True)
-def _advance(k0, force, fs, spike_sample, spike_aff, weights, indptr, members, back_ptr, back, limits, params,
-             code, contact, rate, phase, last_pulse, last_spike, out_t, out_e, out_a, traces):
+def _advance(k0, force, spike_sample, spike_aff, wiring, state, out):
+    """Consume the samples ``k0 ..`` of ``force`` (n, n_electrodes) and their spikes; returns the pulse count.
+
+    ``wiring`` is a `_Wiring`, ``state`` a `_KernelState` (updated in place), ``out`` a `_PulseBuffers` (filled).
+    """
+    weights, indptr, members, back_ptr, back, limits, params, code, contact, fs = wiring
+    rate, phase, last_spike, traces = state.rate, state.phase, state.last_spike, out.traces
     n, n_e = force.shape
     decay = math.exp(-1.0 / (fs * params[0]))
     window = max(int(round(params[2] * fs)), 1)
@@ -224,7 +310,6 @@ def _advance(k0, force, fs, spike_sample, spike_aff, weights, indptr, members, b
             f, amp = _commands(code, e, force[i, e], rate[e], active / max(size, 1), limits, params, contact)
             if force[i, e] <= contact:
                 phase[e] = 0.0
-            count = _pulses(e, k / fs, (k + 1) / fs, f, amp, phase, last_pulse, 1.0 / limits[e, 2],
-                            out_t, out_e, out_a, count)
+            count = _pulses(e, k / fs, (k + 1) / fs, f, amp, 1.0 / limits[e, 2], state, out, count)
             traces[0, i, e], traces[1, i, e], traces[2, i, e] = f, amp, rate[e]
     return count

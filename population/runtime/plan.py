@@ -12,10 +12,10 @@ condition, what can be skipped without changing a single spike:
 * afferents whose current is provably identically zero (no additive noise,
   and zero normal force or AF = 0 with no shear-magnitude term, or zero
   receptive-field weight or gain; for SA-II no bias, no shear and, with
-  ``normal_saii``, no normal force): they stay at their resting fixed point
+  ``TypeParams.normal``, no normal force): they stay at their resting fixed point
   and never spike.  Drive-proportional noise (``noise_cv``) is zero with the
   drive, so it does not stop an afferent from being skipped; nor does the
-  trial excitability (``excite_cv_<type>``), a factor on the current;
+  trial excitability (``<TYPE>.excite_cv``), a factor on the current;
 * noise generation for afferents without noise;
 * recording variables nobody asked for.
 
@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models.afferent_types import AFFERENT_TYPES, afferent_type_codes, normalize_type, type_mask
+from ddmm.models.afferent_types import afferent_type_codes, normalize_type, type_mask
 from ddmm.models.attenuation import F_TH, UNTUNED
 from ddmm.models.variability import bias_multiplier
 from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
@@ -136,7 +136,7 @@ class Plan:
 
     def describe(self, population, scenes) -> str:
         """A printable summary of what is simulated and what is skipped."""
-        n_types = {t: int(np.sum(population.afferent_type[self.selected] == t)) for t in AFFERENT_TYPES}
+        n_types = {t: int(np.sum(population.afferent_type[self.selected] == t)) for t in afferent_type_codes()}
         lines = [f"population {population.name!r}: {len(population)} afferents; simulating "
                  + ", ".join(f"{n} {t}" for t, n in n_types.items() if n)
                  + f"; {self.trials} trial(s); planning {'on' if self.enabled else 'off'}"]
@@ -177,13 +177,14 @@ def _af_note(cond: ConditionPlan) -> str:
 
 def _unit_keys(pop, sel, tuned, scale, local):
     """Rows that identify afferents whose currents are bit-identical (``local``: also their position)."""
-    type_code = np.array([AFFERENT_TYPES.index(t) for t in pop.afferent_type[sel]], dtype=float)
+    codes = afferent_type_codes()
+    type_code = np.array([codes.index(t) for t in pop.afferent_type[sel]], dtype=float)
     nap_code = np.where(tuned, np.unique(pop.nap, return_inverse=True)[1][sel], -1).astype(float)
     theta = np.where(tuned, pop.theta_t[sel], 0.0)
     k = np.where(tuned, pop.k[sel], 0.0)
     columns = [type_code, nap_code, theta, k, scale, pop.sensitivity[sel]]  # sensitivity: gain and dead zone
-    spread = {t: cv for t in AFFERENT_TYPES if (cv := pop.current.for_type(t).bias_cv) > 0.0}
-    if spread:  # each unit's own tonic current (`bias_multiplier`; SA-II's ``bias_cv_saii``)
+    spread = {t: cv for t in afferent_type_codes() if (cv := pop.current.for_type(t).bias_cv) > 0.0}
+    if spread:  # each unit's own tonic current (`bias_multiplier`; SA-II's ``SAII.bias_cv``)
         multiplier = np.ones(sel.size)
         for t, cv in spread.items():
             multiplier = np.where(pop.afferent_type[sel] == t, bias_multiplier(cv, pop.afferent_id[sel]), multiplier)
@@ -204,15 +205,17 @@ def _quiet(pop, sel, scene, scale, computes_af, af_constant):
     blocked = (pop.nap[sel] != UNTUNED) & (not computes_af) & (af_constant == 0.0) & ~_shallow(pop, sel)
     sheared = _shear_gained(pop, sel) & (scene.max_shear() > 0.0)  # the shear-magnitude term drives them
     pressed = (scale == 0.0) | ((blocked | (not np.any(scene.fz > 0.0))) & ~sheared)
-    biased = _of_type(pop.afferent_type[sel], [t for t in AFFERENT_TYPES if pop.current.for_type(t).bias != 0.0])
-    pressing = pop.current.normal_saii > 0.0 and bool(np.any(scene.fz != 0.0))  # `normal_saii`
-    stretched = (scale == 0.0) | ((scene.max_shear() == 0.0) and not pressing)
+    biased = _of_type(pop.afferent_type[sel], [t for t in afferent_type_codes() if pop.current.for_type(t).bias != 0.0])
+    pressing = _of_type(pop.afferent_type[sel], [t for t in afferent_type_codes("stretch_drive")
+                                                 if pop.current.for_type(t).normal > 0.0])  # `TypeParams.normal`
+    pressing &= bool(np.any(scene.fz != 0.0))
+    stretched = (scale == 0.0) | ((scene.max_shear() == 0.0) & ~pressing)
     return np.where(stretch, stretched, pressed) & ~biased & (pop.noise_sigma[sel] == 0.0)
 
 
 def _excitable(pop, sel) -> np.ndarray:
-    """Afferents whose type has a trial excitability (``excite_cv_<type>``): their current differs by trial."""
-    return _of_type(pop.afferent_type[sel], [t for t in AFFERENT_TYPES if pop.current.excite_cv(t) > 0])
+    """Afferents whose type has a trial excitability (``<TYPE>.excite_cv``): their current differs by trial."""
+    return _of_type(pop.afferent_type[sel], [t for t in afferent_type_codes() if pop.current.excite_cv(t) > 0])
 
 
 def _of_type(afferent_type, types) -> np.ndarray:
@@ -224,12 +227,12 @@ def _of_type(afferent_type, types) -> np.ndarray:
 
 
 def _shallow(pop, sel):
-    """Whether each afferent's type keeps part of its normal drive at AF = 0 (``CurrentParams.depth_<type>`` < 1)."""
+    """Whether each afferent's type keeps part of its normal drive at AF = 0 (``CurrentParams.<TYPE>.depth`` < 1)."""
     return _types_where(pop, sel, lambda st: st.depth < 1.0)
 
 
 def _shear_gained(pop, sel):
-    """Whether each afferent's drive has a shear-magnitude term (``CurrentParams.shear_<type>`` > 0)."""
+    """Whether each afferent's drive has a shear-magnitude term (``CurrentParams.<TYPE>.shear`` > 0)."""
     return _types_where(pop, sel, lambda st: st.shear > 0.0)
 
 
@@ -253,8 +256,9 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
                    population_weight(pop, scene.contact)[sel])
     scale = pop.gain[sel] * (1.0 if weights is None else weights)
     noisy = (pop.noise_sigma[sel] > 0) | (pop.noise_cv[sel] > 0) | _excitable(pop, sel)
-    if pop.current.phase_saii > 0.0:  # a keyed start phase per (trial, afferent): no unit shares it
-        noisy |= type_mask(pop.afferent_type[sel], "phase_spread")
+    # A keyed start phase per (trial, afferent) (`TypeParams.phase`): no unit shares it.
+    noisy |= _of_type(pop.afferent_type[sel], [t for t in afferent_type_codes("phase_spread")
+                                               if pop.current.for_type(t).phase > 0.0])
     if not enabled:
         return ConditionPlan(scene.name, scene.n_samples, True, af_constant, weights,
                              np.empty(0, np.int64), np.full(n, -1, np.int64))
@@ -311,7 +315,7 @@ def make_plan(population, scenes, *, afferent_types=None, trials: int = 1, recor
     for name, value, example in named:
         if isinstance(value, str) or not hasattr(value, "__iter__"):
             raise TypeError(f"{name} must be a sequence of names, e.g. {example}, got {type(value).__name__}")
-    requested = (tuple(AFFERENT_TYPES) if afferent_types is None
+    requested = (tuple(afferent_type_codes()) if afferent_types is None
                  else tuple(normalize_type(t, "afferent_types") for t in afferent_types))
     for r in record:
         check_choice(r, "record", RECORD_CHOICES)

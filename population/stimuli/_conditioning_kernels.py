@@ -9,11 +9,61 @@ each; offline and streaming run the same kernels, so they agree bit for bit.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numba as nb
 import numpy as np
 
-__all__ = ["sos_filter", "gate_hold_contact", "hold_band", "hold_counts", "track_noise", "noise_scale", "track_band",
-           "smooth_band"]
+__all__ = ["sos_filter", "gate_hold_contact", "GateSettings", "GateState", "hold_band", "hold_counts", "track_noise",
+           "noise_scale", "track_band", "smooth_band"]
+
+
+class GateSettings(NamedTuple):
+    """The constants of one `gate_hold_contact` call.
+
+    Attributes
+    ----------
+    gate : float
+        The fast band's soft threshold, N, at noise scale 1 (negative: no gate, the hold acts on the input).
+    widths : ndarray, shape (7,)
+        `hold_band`'s widths, N: the hold's per axis (x, y, z; 0: no hold), the contact threshold at which
+        the normal hold narrows to nothing, and the floors per axis (`conditioning.hold_widths`).
+    moves : ndarray, shape (3,)
+        `hold_band`'s rates: the settling's approach per sample, the settling's length in samples and the
+        band's narrowing per dragged sample (`conditioning._hold_moves`).
+    on, off : float
+        Contact hysteresis thresholds on the gated F_Z, N (``on`` also comes off F_Z).
+    deadband : float
+        Tangential magnitude taken off in contact, N.
+    """
+
+    gate: float
+    widths: np.ndarray
+    moves: np.ndarray
+    on: float
+    off: float
+    deadband: float
+
+
+class GateState(NamedTuple):
+    """The state `gate_hold_contact` carries between chunks (arrays, updated in place).
+
+    Attributes
+    ----------
+    held : ndarray, shape (sites, 3)
+        `hold_band`'s held output.
+    track : ndarray, shape (sites, 3, 4)
+        `hold_band`'s drag and settling state.
+    contact : ndarray of bool, shape (sites,)
+        The contact state per site.
+    taken : ndarray, shape (sites,)
+        The part of ``on`` taken off F_Z since the contact's onset, per site, N.
+    """
+
+    held: np.ndarray
+    track: np.ndarray
+    contact: np.ndarray
+    taken: np.ndarray
 
 
 @nb.njit(cache=True, nogil=True)
@@ -136,21 +186,24 @@ def _gated(y, slow, kept, i, s, a, gate):
 
 
 @nb.njit(cache=True, nogil=True)
-def gate_hold_contact(y, slow, smooth, gate, widths, moves, held, track, on, off, deadband, state, taken, scale):
+def gate_hold_contact(y, slow, smooth, scale, settings, carry):
     """The gate, the shear hold, contact and the shear deadband of one chunk (see the module docstring).
 
     ``y`` is the resampled recording (n, sites, 3); ``slow`` and ``smooth``
     are its tracker's slow band and that band smoothed (ignored when
-    ``gate`` is negative: no gate, the hold acts on ``y``; ``widths`` (per
-    axis), ``moves``, ``held`` and ``track`` are `hold_band`'s).  ``scale``
-    (n, sites, 3) is the noise scale per sample (`noise_scale`): it
-    multiplies the gate, the hold's widths, the part of ``on`` taken off
-    F_Z and the hysteresis ``on - off``; in contact the
-    part taken off stays what it was at the onset (``taken``, per site), so
-    the scale's drift does not move a pressed F_Z.  ``held``, ``track``,
-    ``state`` (sites, bool contact) and ``taken`` carry over between chunks.
-    Returns the conditioned forces (n, sites, 3) and the contact (n, sites).
+    ``settings.gate`` is negative: no gate, the hold acts on ``y``; the
+    settings' ``widths`` (per axis) and ``moves``, the carry's ``held`` and
+    ``track`` are `hold_band`'s).  ``scale`` (n, sites, 3) is the noise scale
+    per sample (`noise_scale`): it multiplies the gate, the hold's widths,
+    the part of ``on`` taken off F_Z and the hysteresis ``on - off``; in
+    contact the part taken off stays what it was at the onset (``taken``,
+    per site), so the scale's drift does not move a pressed F_Z.
+    ``settings`` is a `GateSettings`; ``carry`` a `GateState`, updated in
+    place (it carries over between chunks).  Returns the conditioned forces
+    (n, sites, 3) and the contact (n, sites).
     """
+    gate, widths, moves, on, off, deadband = settings
+    held, track, state, taken = carry
     n, sites = y.shape[0], y.shape[1]
     kept = smooth.copy() if gate >= 0.0 else y.copy()
     if widths[:3].max() > 0.0:

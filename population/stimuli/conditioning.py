@@ -69,6 +69,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ddmm.population.stimuli._conditioning_kernels import (
+    GateSettings,
+    GateState,
     gate_hold_contact,
     hold_band,
     hold_counts,
@@ -385,9 +387,10 @@ class Conditioner:
             self._contact, self._taken = np.zeros(sites, bool), np.zeros(sites)
         self._start_hold(kept[0], sites)
         shape = (y.shape[0], sites, 3)
-        return gate_hold_contact(y.reshape(shape), slow.reshape(shape), kept.reshape(shape), gate, widths,
-                                 self._moves, self._held, self._track, s.contact_on_n, s.contact_off_n,
-                                 s.shear_deadband_n, self._contact, self._taken, np.ascontiguousarray(scale))
+        settings = GateSettings(gate, widths, self._moves, s.contact_on_n, s.contact_off_n, s.shear_deadband_n)
+        carry = GateState(self._held, self._track, self._contact, self._taken)
+        return gate_hold_contact(y.reshape(shape), slow.reshape(shape), kept.reshape(shape),
+                                 np.ascontiguousarray(scale), settings, carry)
 
     def _start_hold(self, first, sites):
         """The hold's state, from the first sample it sees (a copy: the hold updates it in place)."""

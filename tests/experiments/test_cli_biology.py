@@ -76,7 +76,7 @@ def test_calibration_reproduces_the_committed_preset():
 
     spec, report = calibrate()
     committed = load_spec("fingertip")
-    assert spec.current.i_sat_sai == pytest.approx(committed.current.i_sat_sai, rel=0.02)
+    assert spec.current.type_params("SAI").i_sat == pytest.approx(committed.current.type_params("SAI").i_sat, rel=0.02)
     assert spec.types["RAI"].nap["none"] == pytest.approx(committed.types["RAI"].nap["none"], abs=0.01)
     assert np.isclose(report["validation"]["mean_sd"]["tuned_fraction.recorded"][0], 0.86, atol=0.03)
     assert all(v["all_pass"] for v in report["validation"]["scorecard_all_pass"].values())

@@ -76,8 +76,8 @@ def test_type_config_box():
     hi = type_config("RAII", np.ones(6), "pass", "peak_bin")
     assert (lo.ramp_s, lo.lift_ramp_s, lo.shear_delay_s, lo.no_shear) == (0.1, 0.1, 0.0, "block")
     assert (hi.ramp_s, hi.lift_ramp_s, hi.sf_definition) == (4.0, 5.0, "peak_bin")
-    assert hi.shear_delay_s == pytest.approx(0.9 * 4.0) and hi.current_params.cutoff_raii_hz == 80.0
-    assert type_config("RAI", np.ones(6), "block", "peak_bin").current_params.cutoff_rai_hz == 300.0
+    assert hi.shear_delay_s == pytest.approx(0.9 * 4.0) and hi.current_params.type_params("RAII").cutoff_hz == 80.0
+    assert type_config("RAI", np.ones(6), "block", "peak_bin").current_params.type_params("RAI").cutoff_hz == 300.0
 
 
 def test_gains_only_calibration_fits_only_the_cmm_column(capsys):
@@ -146,6 +146,7 @@ def test_the_fit_reproduces_the_committed_ra_i_setting():
 
     committed = PAPER_CALIBRATION["RAI"]
     fit = fit_type("RAI", committed.no_shear, committed.sf_definition, seed=0)
-    assert fit["config"].current_params.g_rai == committed.current_params.g_rai
+    assert fit["config"].current_params.gain("RAI") == committed.current_params.gain("RAI")
     assert (fit["config"].ramp_s, fit["config"].lift_ramp_s) == (committed.ramp_s, committed.lift_ramp_s)
-    assert fit["config"].current_params.cutoff_rai_hz == committed.current_params.cutoff_rai_hz
+    assert (fit["config"].current_params.type_params("RAI").cutoff_hz
+            == committed.current_params.type_params("RAI").cutoff_hz)

@@ -102,7 +102,7 @@ def test_the_current_stage_follows_each_declaration(kind):
     st = params.for_type(kind)
     assert st.derivative == info.derivative_order and st.signed == info.stretch_drive
     assert (st.i_sat == 3.0) == info.log_compression and (st.i_sat is None) != info.log_compression
-    own = getattr(params, f"cutoff_{kind.lower()}_hz")
+    own = params.type_params(kind).cutoff_hz
     assert st.cutoff_hz == (own or 30.0 if info.shared_cutoff else own)
     factor = info.fs_per_cutoff or 2.0
     check_fs(factor * 30.0 * 1.01, params, (kind,))  # just fast enough
@@ -184,3 +184,23 @@ def test_the_type_code_check_catches_each_form(tmp_path, monkeypatch):
         'match kind:\n    case "SAII":\n        pass\n'  # 10
         'fine = params.for_type("RAI")\nalso = {"SAI": 1}\nname = "pass" == mode\n')
     assert _type_code_offences(tmp_path / "m.py") == [f"m.py:{n}" for n in (1, 3, 4, 5, 7, 8, 10)]
+
+
+def _code_equalities(path: Path) -> list:
+    """Where ``path`` tests a value for equality with a type code (``== "SAI"``, ``!= "RAII"``)."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Compare) and any(isinstance(op, (ast.Eq, ast.NotEq)) for op in node.ops) \
+                and any(map(_is_code, (node.left, *node.comparators))):
+            found.append(f"{path.relative_to(ROOT)}:{node.lineno}")
+    return found
+
+
+def test_no_equality_with_a_type_code_anywhere_in_the_package():
+    """Outside the type definitions no module tests ``== "<type>"``: behaviour asks the registry, and a protocol
+    selects its units with `is_type` (which takes any spelling)."""
+    files = [p for part in ("ddmm", "models", "population", "experiments") for p in sorted((ROOT / part).rglob("*.py"))
+             if p != DEFINITIONS]
+    assert len(files) > 100
+    offenders = [hit for path in files for hit in _code_equalities(path)]
+    assert not offenders, offenders

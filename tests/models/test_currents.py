@@ -8,12 +8,12 @@ from hypothesis import strategies as st
 from ddmm.models.currents import CurrentParams, afferent_current, lowpass_sos
 
 FS = 1000.0
-UNIT = CurrentParams(g_sai=1.0, g_rai=1.0, g_raii=1.0)
+UNIT = CurrentParams().with_type("SAI", gain=1.0).with_type("RAI", gain=1.0).with_type("RAII", gain=1.0)
 
 
 def test_sai_follows_force():
     f = np.array([[0.0], [1.5], [3.0]])
-    i, state = afferent_current(f, FS, "SAI", CurrentParams(g_sai=2.0))
+    i, state = afferent_current(f, FS, "SAI", CurrentParams().with_type("SAI", gain=2.0))
     np.testing.assert_array_equal(i[:, 0], [0.0, 3.0, 6.0])
     assert state is None
 
@@ -69,21 +69,22 @@ def test_chunked_currents_equal_whole(cuts, kind):
 
 def test_transducer_option_is_linear_for_small_drive():
     f = (np.arange(2000) / FS * 0.01)[:, None]
-    lin, _ = afferent_current(f, FS, "RAI", CurrentParams(g_rai=1.0))
-    comp, _ = afferent_current(f, FS, "RAI", CurrentParams(g_rai=1.0, i_sat=100.0))
+    lin, _ = afferent_current(f, FS, "RAI", CurrentParams().with_type("RAI", gain=1.0))
+    comp, _ = afferent_current(f, FS, "RAI", CurrentParams(i_sat=100.0).with_type("RAI", gain=1.0))
     np.testing.assert_allclose(comp, lin, rtol=1e-3)
     big = np.full((3, 1), 1e4)
     sat, _ = afferent_current(big, FS, "SAI", CurrentParams(i_sat=30.0))
     assert sat.max() < 300.0
 
 
-@pytest.mark.parametrize("kwargs,match", [
-    (dict(g_sai=0.0), "g_sai"), (dict(g_rai=-1.0), "g_rai"), (dict(cutoff_hz=np.nan), "cutoff_hz"),
-    (dict(filter_order=0), "filter_order"), (dict(i_sat=-1.0), "i_sat"),
+@pytest.mark.parametrize("kind,kwargs,match", [
+    ("SAI", {"gain": 0.0}, "^gain "), ("RAI", {"gain": -1.0}, "^gain "), (None, {"cutoff_hz": np.nan}, "cutoff_hz"),
+    (None, {"filter_order": 0}, "filter_order"), (None, {"i_sat": -1.0}, "i_sat"),
 ])
-def test_bad_params(kwargs, match):
+def test_bad_params(kind, kwargs, match):
+    """A shared field through the constructor, a type's through `CurrentParams.with_type`."""
     with pytest.raises(ValueError, match=match):
-        CurrentParams(**kwargs)
+        CurrentParams(**kwargs) if kind is None else CurrentParams().with_type(kind, **kwargs)
 
 
 def test_bad_rates_and_types():

@@ -151,7 +151,8 @@ def test_fused_plan_needs_no_tuned_afferent():
 @pytest.mark.parametrize("method", ["euler", "rk4"])
 def test_fused_spikes_equal_the_direct_engine(method):
     from ddmm.models.engines import integrate
-    from ddmm.models.engines.direct import BLOCK, METHOD_CODES
+    from ddmm.models.engines.direct import BLOCK, METHOD_CODES, Membrane, NeuronTable
+    from ddmm.models.engines.direct_fused import pipeline_spikes
     from ddmm.models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
 
     plan = FusedPipeline(TYPES, NAPS, np.linspace(0, 330, len(TYPES)), np.full(len(TYPES), 3.0), np.full(len(TYPES), 2.0),
@@ -161,11 +162,43 @@ def test_fused_spikes_equal_the_direct_engine(method):
     res = integrate(current, fs=FS, dt=1e-4, afferent_type=np.array(TYPES), engine="direct", method=method)
     p = neuron_arrays(np.array(TYPES))
     v, u = (np.array(x, dtype=float) for x in resting_state(p["b"]))
-    neuron = (10, METHOD_CODES[method], 1.0 * 1e-4 / 0.001, (1.0 * (0.5 * 1e-4)) / 0.001, p["a"], p["b"], p["c"],
-              p["d"], np.zeros(len(TYPES)), V_PEAK, V_FLOOR, BLOCK)
-    _, afferent, step, _, finite, capped = plan.spikes(f, plan.new_state(), False, 0, None, neuron, v, u)
+    neuron = NeuronTable(10, METHOD_CODES[method], 1.0 * 1e-4 / 0.001, (1.0 * (0.5 * 1e-4)) / 0.001, p["a"], p["b"],
+                         p["c"], p["d"], np.zeros(len(TYPES)), V_PEAK, V_FLOOR, BLOCK)
+    mem = Membrane(v, u, np.zeros(len(TYPES)))
+    _, afferent, step, _, finite, capped = pipeline_spikes(plan, f, plan.new_state(), False, 0, None, neuron, mem)
     assert finite and not capped and afferent.size > 10
     order = np.lexsort((afferent, step))
     np.testing.assert_array_equal(afferent[order], res.afferent)
     np.testing.assert_array_equal(step[order], res.step)
     np.testing.assert_array_equal(v, res.state.v)
+
+
+def test_an_engine_that_only_integrates_currents_advances_a_pipeline_as_the_direct_one():
+    """The registry supplies each engine's integrator (`Engine.advance`); an engine with `run` alone gets the
+    pipeline's currents through the seam, with the spikes and state of the direct engine's fused pass."""
+    from ddmm.models.engines import Engine, get_engine
+
+    class CurrentsOnly(Engine):
+        name = "currents-only"
+
+        def run(self, *args, **kwargs):
+            return get_engine("direct").run(*args, **kwargs)
+
+    n = len(TYPES)
+    plan = FusedPipeline(TYPES, NAPS, np.linspace(0, 330, n), np.full(n, 3.0), np.full(n, 2.0), np.full(n, 0.3),
+                         np.full(n, 0.2), PHYSIO, FS, "smooth", 0.1)
+    f, out = forces(3), []
+    for engine in (CurrentsOnly(), "direct"):
+        state, neuron, afferents, steps = plan.new_state(), None, [], []
+        for a, b in ((0, 150), (150, 400)):  # noisy, in two chunks: the state carries over
+            afferent, step, neuron = plan.advance(f[a:b], state, a, 5, neuron, dt=1e-4, method="rk2", engine=engine)
+            afferents.append(afferent)
+            steps.append(step + 10 * a)
+        afferent, step = np.concatenate(afferents), np.concatenate(steps)
+        order = np.lexsort((afferent, step))
+        out.append((afferent[order], step[order], neuron))
+    assert out[0][0].size > 10
+    for x, y in zip(out[0][:2], out[1][:2]):
+        np.testing.assert_array_equal(x, y)
+    for name in ("v", "u", "r"):
+        np.testing.assert_array_equal(getattr(out[0][2], name), getattr(out[1][2], name))

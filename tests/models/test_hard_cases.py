@@ -100,7 +100,7 @@ def test_forces_of_1e4_newton(engine):
 @given(low=st.floats(0.0, 8.0), delta=st.floats(0.0, 8.0))
 def test_sai_rate_non_decreasing_in_normal_force(low, delta):
     fz = np.array([low, low + delta])
-    current = np.repeat(5.367 * fz[None, :], 400, axis=0)  # g_sai * F_A at fixed AF = 1
+    current = np.repeat(5.367 * fz[None, :], 400, axis=0)  # SAI.gain * F_A at fixed AF = 1
     counts = integrate(current, fs=1000.0, dt=1e-4, afferent_type="SAI", engine="direct").counts(2)
     assert counts[1] >= counts[0]
 

@@ -1,7 +1,5 @@
 """Per-unit sensitivity in the current stage: a unit of sensitivity s sees the stimulus scaled by s."""
 
-import dataclasses
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -23,7 +21,8 @@ def _press(n=600, peak=2.0):
 @pytest.mark.parametrize("s", [0.25, 0.5, 2.0, 4.0])
 def test_a_unit_of_sensitivity_s_sees_the_stimulus_times_s(kind, s):
     """Powers of two scale every float exactly: the same bits, not only the same values."""
-    params = dataclasses.replace(PHYSIO, i_max_sai=None, i_max_rai=None, i_max_raii=None, i_sat_sai=None)
+    params = (PHYSIO.with_type("SAI", i_max=None, i_sat=None).with_type("RAI", i_max=None)
+              .with_type("RAII", i_max=None))
     f = _press()
     scaled, _ = afferent_current(f, FS, kind, params, sensitivity=np.array([s]))
     direct, _ = afferent_current(s * f, FS, kind, params)
@@ -31,7 +30,7 @@ def test_a_unit_of_sensitivity_s_sees_the_stimulus_times_s(kind, s):
 
 
 def test_the_dead_zone_is_the_types_over_the_sensitivity():
-    stage = dataclasses.replace(PHYSIO, threshold_rai=0.8).for_type("RAI")
+    stage = PHYSIO.with_type("RAI", threshold=0.8).for_type("RAI")
     np.testing.assert_array_equal(unit_thresholds(stage, np.array([0.5, 1.0, 4.0]), 3), [1.6, 0.8, 0.2])
     np.testing.assert_array_equal(unit_thresholds(stage, None, 2), [0.8, 0.8])
 
@@ -61,6 +60,6 @@ def test_bad_sensitivity_is_refused_naming_it(bad):
 def test_more_sensitive_units_never_get_less_current(s, rate):
     """Monotone in s: a larger sensitivity lowers the dead zone and raises the gain."""
     f = np.clip((np.arange(800) / FS - 0.1) * rate, 0.0, 2.0)[:, None] * np.ones((1, 2))
-    current, _ = afferent_current(f, FS, "RAI", CurrentParams(g_rai=6.0, threshold_rai=1.0, adapt_rai=0.7),
+    current, _ = afferent_current(f, FS, "RAI", CurrentParams().with_type("RAI", gain=6.0, threshold=1.0, adapt=0.7),
                                   sensitivity=np.array([s, 1.5 * s]))
     assert np.all(current[:, 1] >= current[:, 0])

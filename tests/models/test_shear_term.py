@@ -1,4 +1,4 @@
-"""The shear-magnitude term of the pressure types (`CurrentParams.shear_<type>`, `attenuation.shear_drive`)."""
+"""The shear-magnitude term of the pressure types (`TypeParams.shear`, `attenuation.shear_drive`)."""
 
 from dataclasses import replace
 
@@ -12,22 +12,23 @@ from ddmm.population import load_spec, sample_population
 from ddmm.population.simulation import simulate
 from ddmm.population.stimuli.scenes import Scene
 
-PHYSIO = replace(load_spec("fingertip").current, shear_sai=0.5, shear_rai=4.0, shear_raii=1.0, opponent_shear_sai=1.0,
-                 opponent_shear_rai=1.0, opponent_shear_raii=1.0)
+PHYSIO = (load_spec("fingertip").current.with_type("SAI", shear=0.5, opponent_shear=1.0)
+          .with_type("RAI", shear=4.0, opponent_shear=1.0).with_type("RAII", shear=1.0, opponent_shear=1.0))
 
 
 def test_paper_defaults_have_no_shear_term():
     params = CurrentParams()
-    assert (params.shear_sai, params.shear_rai, params.shear_raii, params.opponent_shear_sai) == (0.0, 0.0, 0.0, 0.0)
+    sai, rai, raii = (params.type_params(kind) for kind in ("SAI", "RAI", "RAII"))
+    assert (sai.shear, rai.shear, raii.shear, sai.opponent_shear) == (0.0, 0.0, 0.0, 0.0)
     f_a = np.array([[2.0, 0.4]])
     np.testing.assert_array_equal(shear_drive(f_a, [0.0], [1.0], [[1.0, 0.2]], 0.0, 1.0), f_a)
 
 
-@pytest.mark.parametrize("name", ["shear_sai", "shear_rai", "shear_raii", "opponent_shear_sai", "opponent_shear_rai",
-                                  "opponent_shear_raii"])
-def test_bad_shear_option_is_refused(name):
-    with pytest.raises(ValueError, match=rf"{name} must be a finite number >= 0, got -1\.0"):
-        CurrentParams(**{name: -1.0})
+@pytest.mark.parametrize("kind", ["SAI", "RAI", "RAII"])
+@pytest.mark.parametrize("name", ["shear", "opponent_shear"])
+def test_bad_shear_option_is_refused(name, kind):
+    with pytest.raises(ValueError, match=rf"^{name} must be a finite number >= 0, got -1\.0"):
+        CurrentParams().with_type(kind, **{name: -1.0})
 
 
 def _held(magnitude, direction_deg, n=1500):
@@ -51,7 +52,7 @@ def test_shear_in_the_preferred_direction_raises_the_drive_and_against_it_lowers
     if kind == "SAI":
         opp = [current(m, 270.0) for m in (0.0, 0.25, 0.5, 1.0)]
         assert np.all(np.diff(opp) <= 0) and opp[-1] < opp[0]
-    paper = replace(PHYSIO, shear_sai=0.0, shear_rai=0.0)
+    paper = PHYSIO.with_type("SAI", shear=0.0).with_type("RAI", shear=0.0)
     fx, fy, fz = _held(1.0, 90.0)
     base = compute_currents(fx, fy, fz, fs=1000.0, afferent_type=kind, profile="selective", theta_t=[90.0],
                             no_shear="smooth", current_params=paper)[:, 0]
@@ -74,20 +75,20 @@ def test_plan_keeps_afferents_the_shear_term_drives_without_normal_force():
 
 
 def test_the_attenuation_depth_keeps_part_of_the_normal_force_in_every_direction():
-    """``depth_<type>``: F_A = (1 + depth (AF - 1)) F_Z; 1 is the paper's F_A = AF F_Z, bit for bit."""
+    """``TypeParams.depth``: F_A = (1 + depth (AF - 1)) F_Z; 1 is the paper's F_A = AF F_Z, bit for bit."""
     fx, fy, fz = _held(1.0, 270.0)  # against a selective SA-I tuned to 90 deg: AF = 0.2
     paper = CurrentParams()
 
     def drive(depth):
         return compute_currents(fx, fy, fz, fs=1000.0, afferent_type="SAI", profile="selective", theta_t=[90.0],
-                                no_shear="smooth", current_params=replace(paper, depth_sai=depth))[1000:, 0].mean()
+                                no_shear="smooth", current_params=paper.with_type("SAI", depth=depth))[1000:, 0].mean()
 
     np.testing.assert_array_equal(
         compute_currents(fx, fy, fz, fs=1000.0, afferent_type="SAI", profile="selective", theta_t=[90.0],
-                         no_shear="smooth", current_params=replace(paper, depth_sai=1.0)),
+                         no_shear="smooth", current_params=paper.with_type("SAI", depth=1.0)),
         compute_currents(fx, fy, fz, fs=1000.0, afferent_type="SAI", profile="selective", theta_t=[90.0],
                          no_shear="smooth", current_params=paper))
     assert drive(1.0) < drive(0.5) < drive(0.0)
     np.testing.assert_allclose(attenuated_force([2.0], [[0.2]], 0.5), [[1.2]])
-    with pytest.raises(ValueError, match=r"depth_sai must be a number in \[0, 1\] \(1: the paper's form\), got 1.5"):
-        CurrentParams(depth_sai=1.5)
+    with pytest.raises(ValueError, match=r"^depth must be a number in \[0, 1\] \(1: the paper's form\), got 1.5"):
+        CurrentParams().with_type("SAI", depth=1.5)

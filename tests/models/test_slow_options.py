@@ -1,7 +1,5 @@
 """SA-II's normal drive, tonic spread and start phases; SA-I's dynamic response and lasting fall (CurrentParams)."""
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 
@@ -15,17 +13,18 @@ from ddmm.population import load_spec
 PHYSIO = load_spec("fingertip").current
 
 
-@pytest.mark.parametrize("field, value", [("normal_saii", -0.1), ("bias_cv_saii", float("nan")),
-                                          ("phase_saii", 1.5), ("phase_saii", True), ("dynamic_sai", -1.0),
-                                          ("fall_sai", 1.0), ("tau_dynamic_sai_s", 0.0)])
-def test_bad_values_are_refused_naming_the_option(field, value):
-    with pytest.raises(ValueError, match=field):
-        CurrentParams(**{field: value})
+@pytest.mark.parametrize("kind, field, value", [("SAII", "normal", -0.1), ("SAII", "bias_cv", float("nan")),
+                                                ("SAII", "phase", 1.5), ("SAII", "phase", True),
+                                                ("SAI", "dynamic", -1.0), ("SAI", "fall", 1.0),
+                                                ("SAI", "tau_dynamic_s", 0.0)])
+def test_bad_values_are_refused_naming_the_option(kind, field, value):
+    with pytest.raises(ValueError, match=f"^{field} "):
+        CurrentParams().with_type(kind, **{field: value})
 
 
 def test_defaults_are_the_papers():
-    p = CurrentParams()
-    assert (p.normal_saii, p.bias_cv_saii, p.phase_saii, p.dynamic_sai, p.fall_sai) == (0.0, 0.0, 0.0, 0.0, 0.0)
+    sai, saii = CurrentParams().type_params("SAI"), CurrentParams().type_params("SAII")
+    assert (saii.normal, saii.bias_cv, saii.phase, sai.dynamic, sai.fall) == (0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 def test_saii_drive_rises_with_normal_force():
@@ -46,7 +45,8 @@ def test_tonic_current_is_spread_by_unit_and_the_same_in_every_run():
     plan = FusedPipeline(["SAII"] * 4, ["none"] * 4, [0.0] * 4, [0.0] * 4, [1.0] * 4, [0.0] * 4, [0.0] * 4, PHYSIO,
                          1000.0, "smooth", 0.1, np.arange(4))
     rest = plan.currents(np.zeros((5, 3)), plan.new_state(), False)[-1]
-    np.testing.assert_array_equal(rest, PHYSIO.bias_saii * bias_multiplier(PHYSIO.bias_cv_saii, np.arange(4)))
+    saii = PHYSIO.type_params("SAII")
+    np.testing.assert_array_equal(rest, saii.bias * bias_multiplier(saii.bias_cv, np.arange(4)))
     expected, _ = current_core(np.zeros((5, 4)), 1000.0, "SAII", PHYSIO, afferent_id=np.arange(4))
     np.testing.assert_array_equal(expected[-1], rest)
 
@@ -73,8 +73,8 @@ def _sai_current(params, force, n=3000, rise=100):
 
 @pytest.mark.parametrize("force", [0.5, 8.0])
 def test_sai_current_falls_by_a_fraction_through_a_hold_at_every_force(force):
-    off = _sai_current(replace(PHYSIO, dynamic_sai=0.0, fall_sai=0.0, transient_sai=0.0), force)
-    on = _sai_current(replace(PHYSIO, transient_sai=0.0), force)  # the fast transient has its own test
+    off = _sai_current(PHYSIO.with_type("SAI", dynamic=0.0, fall=0.0, transient=0.0), force)
+    on = _sai_current(PHYSIO.with_type("SAI", transient=0.0), force)  # the fast transient has its own test
     fall_off = 1.0 - off[-500:].mean() / off[100:600].mean()
     fall_on = 1.0 - on[-500:].mean() / on[100:600].mean()
     assert fall_on > fall_off + 0.1  # the lasting fall adds a tenth or more at 0.5 N and at 8 N alike
@@ -106,7 +106,7 @@ def test_the_transient_is_a_band_pass_of_tau_times_the_slope():
 
 
 def test_the_transient_raises_fast_loading_and_leaves_the_plateau():
-    off = _sai_current(replace(PHYSIO, transient_sai=0.0), 4.0, rise=130)
+    off = _sai_current(PHYSIO.with_type("SAI", transient=0.0), 4.0, rise=130)
     on = _sai_current(PHYSIO, 4.0, rise=130)
     assert on[:130].max() > 1.3 * off[:130].max()  # a 30 N/s ramp: the transient's peak
     # gone within a few tau of the hold, but for tau times the slope of the hold's own slow fall (< 0.5%)
@@ -114,10 +114,10 @@ def test_the_transient_raises_fast_loading_and_leaves_the_plateau():
 
 
 @pytest.mark.parametrize(("name", "value", "message"), [
-    ("transient_sai", -1.0, r"transient_sai must be a finite number >= 0, got -1\.0"),
-    ("transient_sai", float("nan"), r"transient_sai must be a finite number >= 0, got nan"),
-    ("tau_transient_sai_s", 0.0, r"tau_transient_sai_s must be a finite number > 0, got 0\.0"),
+    ("transient", -1.0, r"^transient must be a finite number >= 0, got -1\.0"),
+    ("transient", float("nan"), r"^transient must be a finite number >= 0, got nan"),
+    ("tau_transient_s", 0.0, r"^tau_transient_s must be a finite number > 0, got 0\.0"),
 ])
 def test_bad_transient_is_refused(name, value, message):
     with pytest.raises(ValueError, match=message):
-        CurrentParams(**{name: value})
+        CurrentParams().with_type("SAI", **{name: value})

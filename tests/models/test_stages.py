@@ -23,14 +23,14 @@ def test_paper_stage_is_the_default():
     # The defaults are eqs 1-3 verbatim: SAI = g |F|, with no filter and no state.
     f = np.linspace(0.0, 2.0, 50)[:, None]
     i, state = afferent_current(f, FS, "SAI")
-    np.testing.assert_array_equal(i, CurrentParams().g_sai * f)
+    np.testing.assert_array_equal(i, CurrentParams().type_params("SAI").gain * f)
     assert state is None
 
 
 @pytest.mark.parametrize("kind", TYPES)
 def test_zero_force_gives_bias_only(kind):
     i, _ = afferent_current(np.zeros((500, 3)), FS, kind, PHYSIO)
-    np.testing.assert_array_equal(i, PHYSIO.bias_saii if kind == "SAII" else 0.0)
+    np.testing.assert_array_equal(i, PHYSIO.type_params("SAII").bias if kind == "SAII" else 0.0)
 
 
 @settings(max_examples=30, deadline=None)
@@ -41,9 +41,10 @@ def test_transducer_bound_holds_with_receptor_noise(seed, scale, cv, kind):
     f = np.abs(rng.normal(size=(400, 4)).cumsum(axis=0)) * scale
     normals = rng.standard_normal((4, 400))
     i, _ = current_core(f, FS, kind, PHYSIO, None, None, normals, np.full(4, cv))
-    bound = {"SAI": PHYSIO.i_max_sai, "RAI": PHYSIO.i_max_rai, "RAII": PHYSIO.i_max_raii}[kind]
+    params = PHYSIO.type_params(kind)
+    bound = params.i_max
     if kind == "SAI":  # SA-I's dynamic response acts on the bounded current: I + dynamic (I - J) + transient (R - K),
-        bound *= 1.0 + PHYSIO.dynamic_sai + PHYSIO.transient_sai  # J, K >= 0 and R <= the bound
+        bound *= 1.0 + params.dynamic + params.transient  # J, K >= 0 and R <= the bound
     assert np.all(i >= 0.0) and np.all(i <= bound)
 
 
@@ -91,7 +92,7 @@ def test_ra2_is_a_pacinian_band_pass():
 
     def response(freq):
         f = (1.0 + 0.001 * np.sin(2 * np.pi * freq * t))[:, None]
-        i, _ = afferent_current(f, 5000.0, "RAII", PHYSIO.__class__(**{**PHYSIO.__dict__, "i_max_raii": None}))
+        i, _ = afferent_current(f, 5000.0, "RAII", PHYSIO.with_type("RAII", i_max=None))
         return i[2500:].mean()
 
     gains = {f: response(f) for f in (20.0, 100.0, 250.0, 600.0)}
@@ -110,17 +111,18 @@ def test_a_scene_too_slow_for_ra2_is_refused():
 def test_sa2_stretch_raises_and_lowers_the_tonic_current():
     drive = np.r_[np.zeros(200), np.full(800, 1.0), np.full(800, -0.5)][:, None]
     i, _ = afferent_current(drive, FS, "SAII", PHYSIO)
-    assert i[150, 0] == PHYSIO.bias_saii
-    assert i[900, 0] > PHYSIO.bias_saii + 3.0 and i[1700, 0] < PHYSIO.bias_saii - 1.0
+    bias = PHYSIO.type_params("SAII").bias
+    assert i[150, 0] == bias
+    assert i[900, 0] > bias + 3.0 and i[1700, 0] < bias - 1.0
 
 
-@pytest.mark.parametrize("field,value", [("i_max_rai", -1.0), ("tau_sai_s", 0.0), ("adapt_rai", -0.1),
-                                         ("threshold_rai", np.nan), ("order_raii", 9), ("cutoff_raii_hz", 0.0),
-                                         ("negative_weight_rai", 1.5), ("negative_weight_raii", -0.1),
-                                         ("negative_weight_rai", np.nan)])
-def test_bad_stage_parameters_are_named(field, value):
-    with pytest.raises(ValueError, match=field):
-        CurrentParams(**{field: value})
+@pytest.mark.parametrize("kind,field,value", [("RAI", "i_max", -1.0), ("SAI", "tau_s", 0.0), ("RAI", "adapt", -0.1),
+                                              ("RAI", "threshold", np.nan), ("RAII", "order", 9),
+                                              ("RAII", "cutoff_hz", 0.0), ("RAI", "negative_weight", 1.5),
+                                              ("RAII", "negative_weight", -0.1), ("RAI", "negative_weight", np.nan)])
+def test_bad_stage_parameters_are_named(kind, field, value):
+    with pytest.raises(ValueError, match=f"^{field} "):
+        CurrentParams().with_type(kind, **{field: value})
 
 
 @pytest.mark.parametrize("kind", ["RAI", "RAII"])
@@ -131,7 +133,7 @@ def test_the_negative_half_wave_is_weighted(kind):
     paper, _ = afferent_current(f, FS, kind, CurrentParams())
     assert np.all(paper >= 0.0)
     for w in (0.0, 0.25):
-        half, _ = afferent_current(f, FS, kind, CurrentParams(**{f"negative_weight_{kind.lower()}": w}))
+        half, _ = afferent_current(f, FS, kind, CurrentParams().with_type(kind, negative_weight=w))
         signed = np.sign(_signed_derivative(f, kind))
         assert (signed < 0).sum() > 500 and (signed > 0).sum() > 500
         np.testing.assert_allclose(half[signed > 0, 0], paper[signed > 0, 0], rtol=1e-9, atol=1e-9)

@@ -133,7 +133,8 @@ def test_a_multistage_method_refuses_a_negative_drive_from_the_pipeline(engine):
     from ddmm.models.currents import CurrentParams
     from ddmm.models.engines import NumericalInstabilityError
 
-    pop = make_population(["SAII"], theta_t=0.0, nap="selective", current=CurrentParams(opponent_saii=1.0, g_saii=10.0))
+    pop = make_population(["SAII"], theta_t=0.0, nap="selective",
+                          current=CurrentParams().with_type("SAII", opponent=1.0, gain=10.0))
     scene = Scene(np.full(50, -5.0), np.zeros(50), np.full(50, 1.0), fs=500.0)
     with pytest.raises(NumericalInstabilityError, match="unstable for currents down to -30 mV/ms"):
         simulate(pop, scene, engine=engine, dt=2e-3, method="rk4", seed=0, quiet=True)

@@ -198,12 +198,12 @@ def test_a_full_amplitude_command_never_rounds_over_the_electrode_maximum(code):
 
 def test_the_last_check_drops_a_pulse_closer_than_the_rate_limit_allows():
     """Even a command over the limit (which no rule gives) cannot place two pulses too close."""
-    from ddmm.population.neurostim.pulses import _pulses
+    from ddmm.population.neurostim.pulses import _KernelState, _PulseBuffers, _pulses
 
-    out_t, out_e, out_a = np.empty(100), np.empty(100, np.int64), np.empty(100)
-    phase, last = np.zeros(1), np.full(1, -np.inf)
-    count = _pulses(0, 0.0, 0.1, 1000.0, 50.0, phase, last, 1.0 / 300.0, out_t, out_e, out_a, 0)
-    assert count > 10 and np.all(np.diff(out_t[:count]) >= 1.0 / 300.0)
+    out = _PulseBuffers(np.empty(100), np.empty(100, np.int64), np.empty(100), np.zeros((3, 1, 1)))
+    state = _KernelState(np.zeros(1), np.zeros(1), np.full(1, -np.inf), np.zeros(1, np.int64))
+    count = _pulses(0, 0.0, 0.1, 1000.0, 50.0, 1.0 / 300.0, state, out, 0)
+    assert count > 10 and np.all(np.diff(out.time[:count]) >= 1.0 / 300.0)
 
 
 # ---- what the rules do -------------------------------------------------------------------------------------

@@ -24,15 +24,22 @@ def fingertip():
 
 
 #: The term's candidate gains (the presets keep it off: docs/model.md, "What changed in the model").
-ON = {"shear_sai": 0.5, "shear_rai": 4.0, "shear_raii": 1.0, "opponent_shear_sai": 1.0, "opponent_shear_rai": 1.0,
-      "opponent_shear_raii": 1.0}
+ON = {"SAI": {"shear": 0.5, "opponent_shear": 1.0}, "RAI": {"shear": 4.0, "opponent_shear": 1.0},
+      "RAII": {"shear": 1.0, "opponent_shear": 1.0}}
+
+
+def _with(params, changes):
+    """``params`` with ``changes`` (type -> `TypeParams` fields) applied."""
+    for kind, fields in changes.items():
+        params = params.with_type(kind, **fields)
+    return params
 
 
 def test_shear_term_passes_and_the_paper_form_fails(fingertip):
-    on = replace(fingertip, current=replace(fingertip.current, **ON))
+    on = replace(fingertip, current=_with(fingertip.current, ON))
     rows, _ = physiology.score_physiology(on, PHYSIOLOGY_REFERENCE, properties=NAMES, seed=0)
     assert all(r["pass"] for r in rows), [r["name"] for r in rows if not r["pass"]]
-    paper = replace(fingertip, current=replace(fingertip.current, shear_sai=0.0, shear_rai=0.0, shear_raii=0.0))
+    paper = replace(fingertip, current=_with(fingertip.current, {kind: {"shear": 0.0} for kind in ON}))
     rows, _ = physiology.score_physiology(paper, PHYSIOLOGY_REFERENCE, properties=NAMES, seed=0)
     failing = {r["name"] for r in rows if not r["pass"]}
     assert {"shear_pref_SAI", "shear_ramp_RAI", "shear_dir_RAI"} <= failing

@@ -37,7 +37,7 @@ def test_preset_passes_the_slow_rows(slow_pop):
 
 def test_without_the_options_the_slow_rows_fail(slow_pop):
     """The paper-like SA-II (no normal drive, one bias, start at rest) and SA-I without the dynamic stage fail."""
-    off = replace(slow_pop.current, normal_saii=0.0, bias_cv_saii=0.0, phase_saii=0.0, dynamic_sai=0.0, fall_sai=0.0)
+    off = slow_pop.current.with_type("SAII", normal=0.0, bias_cv=0.0, phase=0.0).with_type("SAI", dynamic=0.0, fall=0.0)
     values = _values(replace(slow_pop, current=off), ["normal_coding_SAII", "rest_spread_SAII", "start_synchrony_SAII",
                                                        "adaptation_8N_SAI"])
     assert not any(ok for _, ok in values.values()), values
@@ -47,6 +47,6 @@ def test_sa_i_peaks_need_the_transient_and_the_plateau_keeps_to_force(slow_pop):
     names = ["peak_rate_SAI", "peak_rate_2N_SAI", "plateau_rate_SAI"]
     values = _values(slow_pop, names)
     assert all(ok for _, ok in values.values()), values
-    values = _values(replace(slow_pop, current=replace(slow_pop.current, transient_sai=0.0)), names)
+    values = _values(replace(slow_pop, current=slow_pop.current.with_type("SAI", transient=0.0)), names)
     assert not values["peak_rate_SAI"][1] and not values["peak_rate_2N_SAI"][1], values
     assert values["plateau_rate_SAI"][1], values  # the plateau never depended on the transient

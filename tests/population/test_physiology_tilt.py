@@ -54,6 +54,6 @@ def _values(pop):
 def test_preset_passes_and_the_papers_attenuation_alone_fails(few):
     values = _values(few)
     assert all(ok for _, ok in values.values()), values
-    paper = replace(few.current, depth_sai=1.0, shear_sai=0.0, opponent_shear_sai=0.0)
+    paper = few.current.with_type("SAI", depth=1.0, shear=0.0, opponent_shear=0.0)
     values = _values(replace(few, current=paper))
     assert not values["tilt_above_SAI"][1] and not values["tilt_variant_above_SAI"][1], values

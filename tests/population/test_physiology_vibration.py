@@ -29,7 +29,7 @@ def test_the_presets_lock_and_the_papers_drive_does_not(fingertip):
     assert all(r["pass"] for r in rows), [(r["name"], r["value"]) for r in rows]
     assert data["phase_locking"]["RAI"]["phases"].size > 100
     # The paper's |dF_A/dt| with the old smoothing (tau 30 ms, i_max 100) locks to 2f, not to f.
-    paper = dataclasses.replace(fingertip.current, negative_weight_rai=1.0, tau_rai_s=0.03, i_max_rai=100.0)
+    paper = fingertip.current.with_type("RAI", negative_weight=1.0, tau_s=0.03, i_max=100.0)
     rows, _ = score_physiology(dataclasses.replace(fingertip, current=paper), PHYSIOLOGY_REFERENCE,
                                properties=ROWS, seed=0)
     values = {r["name"]: r["value"] for r in rows}

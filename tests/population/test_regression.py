@@ -59,8 +59,8 @@ from ._pinned_digest import AFFERENTS, pinned_env
 #: Re-recorded when units took a per-unit sensitivity (docs/model.md, "Units that differ"): the presets
 #: switched on its spread, FA-I's dead zone went 2 -> 0.75 N/s and the NAP mixes were refitted (with the
 #: presets of before the code gave the previous digests, afb0ae7e..., 22108, 196b701d...).
-#: Re-recorded when SA-I took `depth_sai` 0.5, the re-tuned shear term and the fast transient
-#: (`transient_sai`, `adapt_sai` 1 -> 0.7).  With the presets of before (`BEFORE`, run from
+#: Re-recorded when SA-I took `SAI.depth` 0.5, the re-tuned shear term and the fast transient
+#: (`SAI.transient`, `SAI.adapt` 1 -> 0.7).  With the presets of before (`BEFORE`, run from
 #: `_pinned_digest.BEFORE_PRESETS`) the code still gives the earlier digests, and this test holds it to them.
 RECORDED = {
     "spikes": "3028bfece619d2c9463dd24e1451fa6df75f114205f3248187f1b21fe8913ce5",

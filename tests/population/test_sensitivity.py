@@ -55,7 +55,7 @@ def test_a_population_refuses_a_sensitivity_not_above_zero(bad):
 
 
 def test_the_planner_keeps_units_of_other_sensitivity_apart():
-    params = dataclasses.replace(load_spec("fingertip").current, excite_cv_rai=0.0)  # noise-free: shared
+    params = load_spec("fingertip").current.with_type("RAI", excite_cv=0.0)  # noise-free: shared
     same = make_population(["RAI"] * 3, nap="none", current=params)
     apart = make_population(["RAI"] * 3, nap="none", current=params, sensitivity=[1.0, 1.0, 2.0])
     scene = birznieks(90.0)

@@ -20,7 +20,7 @@ SCHEMA_COORDS = {"afferent", "afferent_type", "theta_t", "nap", "k", "gain", "x_
                  "region", "frame_deg", "condition", "duration", "theta_r", "has_theta_r", "trial", "time"}
 SCHEMA_VARS = {"spike_count", "spike_time", "spike_afferent", "spike_trial", "spike_condition", "fx", "fy", "fz",
                "stage_start", "stage_end"}
-ATTRS = {"engine", "dt", "method", "seed", "no_shear", "ddmm_version", "f_th", "current_g_sai",
+ATTRS = {"engine", "dt", "method", "seed", "no_shear", "ddmm_version", "f_th", "current_SAI_gain",
          "neuron_SAI_b", "rf_sigma_RAII_mm"}
 
 
@@ -78,7 +78,8 @@ def test_failed_write_leaves_no_file(small, tmp_path, monkeypatch):
 
     def boom(*args, **kwargs):
         raise OSError("disk full")
-    monkeypatch.setattr(xr.Dataset, "to_netcdf", boom)
+    for method in ("to_netcdf", "dump_to_store"):  # either writes the file (`ddmm.utils.files.write_netcdf`)
+        monkeypatch.setattr(xr.Dataset, method, boom)
     with pytest.raises(OSError):
         save_dataset(ds, tmp_path / "run.nc")
     assert list(tmp_path.iterdir()) == []

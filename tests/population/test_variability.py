@@ -1,4 +1,4 @@
-"""Trial-to-trial excitability (``excite_cv_<type>``) and the variability protocol of the scorecard."""
+"""Trial-to-trial excitability (``TypeParams.excite_cv``) and the variability protocol of the scorecard."""
 
 import dataclasses
 
@@ -13,8 +13,8 @@ from ddmm.population.runtime.plan import make_plan
 
 
 def test_bad_excite_cv_is_named():
-    with pytest.raises(ValueError, match=r"excite_cv_rai must be a finite number >= 0, got -0.1"):
-        CurrentParams(excite_cv_rai=-0.1)
+    with pytest.raises(ValueError, match=r"^excite_cv must be a finite number >= 0, got -0.1"):
+        CurrentParams().with_type("RAI", excite_cv=-0.1)
 
 
 def test_excitability_is_keyed_lognormal_of_mean_one():
@@ -27,8 +27,8 @@ def test_excitability_is_keyed_lognormal_of_mean_one():
 
 
 def _pop(excite_cv, n=30):
-    pop = make_population(["SAI"] * n, noise_cv=0.0, current=dataclasses.replace(
-        sample_population("fingertip", rng=0).current, excite_cv_sai=excite_cv))
+    pop = make_population(["SAI"] * n, noise_cv=0.0, current=sample_population("fingertip", rng=0).current.with_type(
+        "SAI", excite_cv=excite_cv))
     return pop
 
 
@@ -50,8 +50,8 @@ def test_variability_protocol_on_the_preset():
     scene = press_scene()
     stats = variability_stats(simulate(sub, [scene], trials=20, seed=0, quiet=True), 0.2, 0.45)
     assert 0.1 <= stats["fano_SAI"] <= 1.0 and 0.5 <= stats["first_jitter_SAI"] <= 10.0
-    off = dataclasses.replace(sub, current=dataclasses.replace(sub.current, excite_cv_sai=0.0, excite_cv_rai=0.0,
-                                                                excite_cv_raii=0.0))
+    off = dataclasses.replace(sub, current=sub.current.with_type("SAI", excite_cv=0.0).with_type("RAI", excite_cv=0.0)
+                              .with_type("RAII", excite_cv=0.0))
     base = variability_stats(simulate(off, [scene], trials=20, seed=0, quiet=True), 0.2, 0.45)
     assert base["fano_SAI"] < 0.05  # without it nearly deterministic (the reviewer's finding)
 
