@@ -90,7 +90,7 @@ def shared_drive(f, lo, hi, aff_f, af, cached, sample, reading, group):
         f[lo:hi] = 1.0
     f = f[lo:hi]  # a view from 0: loops over range(lo, hi) vectorise worse
     if group.stretch:
-        opponent, normal = reading.opponent, reading.normal
+        opponent, normal = group.opponent, group.normal
         for j in range(f.size):
             f[j] = mag * (f[j] - opponent * (1.0 - f[j]))
         if normal != 0.0:  # SA-II's normal-force drive (`stretch_drive`)
@@ -138,10 +138,10 @@ def local_drive(f, lo, hi, local, aff_f, mags, wts, reading, group):
         f[j] = p
     if group.stretch:
         for j in range(lo, hi):
-            f[j] = mags[j] * (f[j] - reading.opponent * (1.0 - f[j]))
-        if reading.normal != 0.0:
+            f[j] = mags[j] * (f[j] - group.opponent * (1.0 - f[j]))
+        if group.normal != 0.0:
             for j in range(lo, hi):
-                f[j] = f[j] + reading.normal * local[2, j]
+                f[j] = f[j] + group.normal * local[2, j]
     elif group.shear_g != 0.0 or group.depth != 1.0:
         for j in range(lo, hi):
             f[j] = _sheared(f[j], local[2, j], mags[j], wts[j], reading, group)

@@ -27,7 +27,6 @@ __all__ = [
     "ShearSample",
     "afferent_table",
     "group_tables",
-    "stretch_options",
     "transducer_runs",
     "type_runs",
 ]
@@ -37,8 +36,8 @@ _COS, _SIN, _K, _P1, _P2, _P3, _P4, _P5, _TIP, _GAIN, _CV, _SIGMA, _TONIC, _DEAD
 _N_AFF_ROWS = 14
 # Rows of the per-group float and integer tables.
 (_ADAPT, _ALPHA_ADAPT, _THRESHOLD, _ALPHA_SMOOTH, _BIAS, _NEGATIVE, _DYN, _ALPHA_DYN, _FALL, _SHEAR_G, _OPP_SHEAR,
- _DEPTH, _TRANSIENT, _ALPHA_TRANSIENT, _ALPHA_RISE) = range(15)
-_N_GRP_ROWS = 15
+ _DEPTH, _TRANSIENT, _ALPHA_TRANSIENT, _ALPHA_RISE, _OPP_STRETCH, _NORMAL) = range(17)
+_N_GRP_ROWS = 17
 _NSEC, _ORDER, _SIGNED, _PLAIN, _NOISY, _SMOOTHED, _TUNED_G, _START, _STOP = range(9)
 _N_GRP_INT_ROWS = 9
 # Rows of the state after the 2 * n_sections filter rows.
@@ -48,19 +47,6 @@ _N_STATE = 8
 _RANGE = 512  # afferents per range of the front pass: its state and scratch fit in cache
 _SLICE = 1 << 17  # current elements per time slice of `FusedPipeline.currents`
 _NO_FORCES, _NO_SITES, _NO_WEIGHTS = np.zeros((0, 3)), np.zeros((0, 0, 3)), np.zeros((0, 0))
-
-
-def stretch_options(consts) -> tuple:
-    """(opponent, normal) of the stretch-drive types among ``consts`` (`type_filter_constants` per run; 0 without).
-
-    The front pass takes one pair: stretch-drive types whose pairs differ
-    cannot share a pipeline (the package has one such type, SA-II).
-    """
-    pairs = {(float(st.opponent), float(st.normal)) for st, *_ in consts if st.signed}
-    if len(pairs) > 1:
-        raise ValueError(f"stretch-drive types with different opponent/normal weights cannot share one pipeline, "
-                         f"got {sorted(pairs)}")
-    return pairs.pop() if pairs else (0.0, 0.0)
 
 
 class FusedTables(NamedTuple):
@@ -74,7 +60,7 @@ class FusedTables(NamedTuple):
     aff_f : ndarray
         Per-afferent floats, shape (14, n_afferents): rows `_COS`..`_DEAD` (direction, profile, gain, noise).
     grp_f : ndarray
-        Per-group floats, shape (15, n_groups): rows `_ADAPT`..`_ALPHA_RISE` (stage constants).
+        Per-group floats, shape (17, n_groups): rows `_ADAPT`..`_NORMAL` (stage constants).
     grp_i : ndarray
         Per-group integers, shape (9, n_groups): rows `_NSEC`..`_STOP` (sections, flags, span).
     sos : ndarray
@@ -87,10 +73,6 @@ class FusedTables(NamedTuple):
         AF at or below ``f_th`` otherwise: 1.0 ("pass") or 0.0 ("block").
     f_th : float
         Shear threshold (N).
-    opponent : float
-        The stretch-drive types' (SA-II's) weight of stretch against their direction (`TypeParams.opponent`).
-    normal : float
-        Their normal-force drive (`TypeParams.normal`).
     weights : ndarray
         Each afferent's coefficients of the site forces, (n_sites, n_afferents); (0, 0) if none.
     mixed : bool
@@ -107,8 +89,6 @@ class FusedTables(NamedTuple):
     smooth_reading: bool
     outside_value: float
     f_th: float
-    opponent: float
-    normal: float
     weights: np.ndarray
     mixed: bool
     sigma_idx: np.ndarray
@@ -165,6 +145,10 @@ class GroupDrive(NamedTuple):
         Its opponent weight.
     depth : float
         Depth of the normal force's attenuation (`attenuation.attenuated_force`).
+    opponent : float
+        A stretch drive's weight of stretch against the preferred direction (`TypeParams.opponent`).
+    normal : float
+        A stretch drive's normal-force weight (`TypeParams.normal`).
     """
 
     tuned: bool
@@ -172,6 +156,8 @@ class GroupDrive(NamedTuple):
     shear_g: float
     opp_s: float
     depth: float
+    opponent: float
+    normal: float
 
 
 class ShearSample(NamedTuple):
@@ -210,17 +196,11 @@ class DriveConstants(NamedTuple):
         AF at or below ``f_th`` otherwise.
     f_th : float
         Shear threshold (N).
-    opponent : float
-        SA-II's weight of stretch against its direction.
-    normal : float
-        SA-II's normal-force drive.
     """
 
     smooth_reading: bool
     outside_value: float
     f_th: float
-    opponent: float
-    normal: float
 
 
 def type_runs(afferent_type, nap) -> list:
@@ -275,7 +255,7 @@ def group_tables(spans, consts, noise_cv, tuned, fs):
                        float(-np.expm1(-1.0 / (fs * st.tau_dynamic_s))), st.fall,  # `currents._alpha`
                        st.shear, st.opponent_shear, st.depth, st.transient,
                        float(-np.expm1(-1.0 / (fs * st.tau_transient_s))),
-                       float(-np.expm1(-1.0 / (fs * 0.5 * st.tau_transient_s)))]
+                       float(-np.expm1(-1.0 / (fs * 0.5 * st.tau_transient_s))), st.opponent, st.normal]
         grp_i[:, g] = [sos.shape[0], st.derivative, st.signed, plain, np.any(noise_cv[a:b] > 0),
                        st.tau_s is not None, tuned[a], a, b]
     return grp_f, grp_i, sos_all

@@ -70,9 +70,11 @@ from ddmm.models._fused_tables import (
     _NO_SITES,
     _NO_WEIGHTS,
     _NOISY,
+    _NORMAL,
     _NSEC,
     _OFFSET,
     _OPP_SHEAR,
+    _OPP_STRETCH,
     _ORDER,
     _PLAIN,
     _RANGE,
@@ -99,7 +101,6 @@ from ddmm.models._fused_tables import (
     NoiseKey,
     afferent_table,
     group_tables,
-    stretch_options,
     transducer_runs,
     type_runs,
 )
@@ -166,7 +167,7 @@ def _front_range(tables, state, forces, noise, started, out, a0, a1):
     receptor noise; ``started`` is False on a scene's first chunk.
     """
     aff_f, grp_f, grp_i, sos, rows = tables.aff_f, tables.grp_f, tables.grp_i, tables.sos, 2 * tables.sos.shape[1]
-    reading = DriveConstants(tables.smooth_reading, tables.outside_value, tables.f_th, tables.opponent, tables.normal)
+    reading = DriveConstants(tables.smooth_reading, tables.outside_value, tables.f_th)
     z, offset, (key, noisy, ids, sample0) = state[:rows], state[rows + _OFFSET], noise
     tail = TailState(offset, state[rows + _Y1], state[rows + _Y2], state[rows + _SLOW])
     unit = UnitScales(aff_f[_GAIN], aff_f[_DEAD], aff_f[_CV])
@@ -179,7 +180,7 @@ def _front_range(tables, state, forces, noise, started, out, a0, a1):
             if lo >= hi:
                 continue
             group = GroupDrive(grp_i[_TUNED_G, g] != 0, grp_i[_SIGNED, g] != 0, grp_f[_SHEAR_G, g],
-                               grp_f[_OPP_SHEAR, g], grp_f[_DEPTH, g])
+                               grp_f[_OPP_SHEAR, g], grp_f[_DEPTH, g], grp_f[_OPP_STRETCH, g], grp_f[_NORMAL, g])
             if mixed:
                 local_drive(f, lo, hi, local, aff_f, mags, wts, reading, group)
             elif not group.tuned and not group.stretch and group.shear_g == 0.0:
@@ -324,7 +325,7 @@ class FusedPipeline:
         grp_f, grp_i, sos = group_tables(spans, consts, noise_cv, nap != UNTUNED, self.fs)
         self.rows = 2 * sos.shape[1]
         self.tables = FusedTables(aff_f, grp_f, grp_i, sos, self.fs, no_shear == "smooth",
-                                  1.0 if no_shear == "pass" else 0.0, float(f_th), *stretch_options(consts),
+                                  1.0 if no_shear == "pass" else 0.0, float(f_th),
                                   _NO_WEIGHTS if mixing is None else self.mixing,
                                   mixing is not None, np.flatnonzero(noise_sigma > 0).astype(np.int64))
         self.kernel_tables = tuple(self.tables)  # as the kernels take it from Python

@@ -112,3 +112,27 @@ def test_its_receptive_field_is_the_declared_one(toy):
     assert np.all(weight[2::2] > weight[3::2])  # 20 mm^2 against SA-I's 11: a wider field
     ds = simulate(line, scene, engine="direct", seed=0, quiet=True)
     assert int(ds.spike_count[..., 0].sum()) > int(ds.spike_count[..., 6].sum())  # the centre fires more
+
+
+def test_two_stretch_drive_types_keep_their_own_weights(monkeypatch):
+    """A second stretch-drive type beside SA-II, with other opponent and normal weights: in one population each
+    type's spikes are those it fires alone (the front pass reads the weights per group)."""
+    monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))
+    monkeypatch.setattr(registry, "_CODE_OF", dict(registry._CODE_OF))
+    register_afferent_type(AfferentType("STR", "STR-II", stretch_drive=True, log_compression=False,
+                                        current=TypeParams(gain=6.0, cutoff_hz=20.0, opponent=0.9, normal=0.6,
+                                                           bias=5.5, i_max=40.0)))
+    spec = {"name": "two", "region": {"center_mm": [0.0, 0.0], "semi_axes_mm": [6.0, 8.0]},
+            "current": {"SAII": {"gain": 4.0, "opponent": 0.2, "bias": 5.5}},
+            "types": {"SAII": {"count": 10, "nap": {"broad": 1.0}}, "STR": {"count": 10, "nap": {"broad": 1.0}}}}
+    pop = sample_population(spec_from_dict(spec), rng=1)
+    scenes = [birznieks(0.0), birznieks(180.0)]
+    both = simulate(pop, scenes, engine="direct", seed=2, quiet=True)
+    for code in ("SAII", "STR"):
+        alone = simulate(pop.select(pop.afferent_type == code), scenes, engine="direct", seed=2, quiet=True)
+        np.testing.assert_array_equal(both.spike_count.sel(afferent=alone.afferent.values), alone.spike_count)
+    other = dataclasses.replace(pop, current=pop.current.with_type("STR", opponent=0.2, normal=0.0))  # SA-II's
+    moved = simulate(other, scenes, engine="direct", seed=2, quiet=True)
+    saii = pop.afferent_type == "SAII"
+    np.testing.assert_array_equal(moved.spike_count[..., saii], both.spike_count[..., saii])
+    assert int(np.abs(moved.spike_count[..., ~saii] - both.spike_count[..., ~saii]).sum()) > 0
