@@ -37,7 +37,7 @@ import numpy as np
 
 from ddmm.experiments.paper.cells import paper_value, type_cells
 from ddmm.experiments.paper.reproduce import ReproConfig
-from ddmm.models.afferent_types import PAPER_TYPES
+from ddmm.models.afferent_types import PAPER_TYPES, afferent_type_info
 from ddmm.models.current_params import CurrentParams
 from ddmm.utils.deprecation import renamed_keyword
 
@@ -52,7 +52,6 @@ FIT_CELLS = (("II", "selective", "PRSI"), ("II", "broad", "PRSI")) \
 READINGS = ("pass", "block")
 DEFINITIONS = ("contact_mean", "peak_bin")
 _CUTOFF = ("RAI", "RAII")  # the types whose cut-off is fitted
-_ORDER = {"SAI": 0, "RAI": 1, "RAII": 2}  # the derivative order: a ramp's drive scales as ramp_s ** -order
 # The unit box's axes: gain factor (log, 0.01-50 at the reference ramp), cut-off (Hz), ramp, lift (s),
 # shear onset (fraction of the push ramp), Birznieks shear onset (s).
 _BOX = ((math.log(0.01), math.log(50.0)), (5.0, 80.0), (0.1, 4.0), (0.1, 5.0), (0.0, 0.9), (0.0, 0.1))
@@ -65,6 +64,12 @@ _POLISH_SIGMAS = (0.08, 0.04, 0.02, 0.01)
 _REFERENCE_RAMP_S = 2.0
 
 
+def _order(kind: str) -> int:
+    """The derivative order of a type's drive (`AfferentType.derivative_order`): a ramp's drive scales as
+    ``ramp_s ** -order``."""
+    return afferent_type_info(kind).derivative_order
+
+
 def type_config(kind: str, u, reading: str, definition: str, base: ReproConfig = ReproConfig()) -> ReproConfig:
     """The `ReproConfig` of one type at a point ``u`` of the unit box (6 coordinates in [0, 1])."""
     u = np.clip(np.asarray(u, dtype=float), 0.0, 1.0)
@@ -73,7 +78,7 @@ def type_config(kind: str, u, reading: str, definition: str, base: ReproConfig =
     v = [lo + x * (hi - lo) for x, (lo, hi) in zip(u, box)]
     ramp = v[2]
     # the gain is scaled with the ramp so that one coordinate sets the ramp's drive whatever its length
-    gain = CurrentParams().gain(kind) * math.exp(v[0]) * (ramp / _REFERENCE_RAMP_S) ** _ORDER[kind]
+    gain = CurrentParams().gain(kind) * math.exp(v[0]) * (ramp / _REFERENCE_RAMP_S) ** _order(kind)
     fields = {"gain": round(float(gain), 6)}
     if kind in _CUTOFF:
         fields["cutoff_hz"] = round(float(v[1]), 3)

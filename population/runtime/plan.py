@@ -205,9 +205,8 @@ def _quiet(pop, sel, scene, scale, computes_af, af_constant):
     blocked = (pop.nap[sel] != UNTUNED) & (not computes_af) & (af_constant == 0.0) & ~_shallow(pop, sel)
     sheared = _shear_gained(pop, sel) & (scene.max_shear() > 0.0)  # the shear-magnitude term drives them
     pressed = (scale == 0.0) | ((blocked | (not np.any(scene.fz > 0.0))) & ~sheared)
-    biased = _of_type(pop.afferent_type[sel], [t for t in afferent_type_codes() if pop.current.for_type(t).bias != 0.0])
-    pressing = _of_type(pop.afferent_type[sel], [t for t in afferent_type_codes("stretch_drive")
-                                                 if pop.current.for_type(t).normal > 0.0])  # `TypeParams.normal`
+    biased = _types_where(pop, sel, lambda st: st.bias != 0.0, None)
+    pressing = _types_where(pop, sel, lambda st: st.normal > 0.0, "stretch_drive")  # `TypeParams.normal`
     pressing &= bool(np.any(scene.fz != 0.0))
     stretched = (scale == 0.0) | ((scene.max_shear() == 0.0) & ~pressing)
     return np.where(stretch, stretched, pressed) & ~biased & (pop.noise_sigma[sel] == 0.0)
@@ -228,18 +227,22 @@ def _of_type(afferent_type, types) -> np.ndarray:
 
 def _shallow(pop, sel):
     """Whether each afferent's type keeps part of its normal drive at AF = 0 (``CurrentParams.<TYPE>.depth`` < 1)."""
-    return _types_where(pop, sel, lambda st: st.depth < 1.0)
+    return _types_where(pop, sel, lambda st: st.depth < 1.0, _pressure)
 
 
 def _shear_gained(pop, sel):
     """Whether each afferent's drive has a shear-magnitude term (``CurrentParams.<TYPE>.shear`` > 0)."""
-    return _types_where(pop, sel, lambda st: st.shear > 0.0)
+    return _types_where(pop, sel, lambda st: st.shear > 0.0, _pressure)
 
 
-def _types_where(pop, sel, holds):
-    """Whether each afferent's pressure type (F_A, not a stretch drive) has resolved current parameters for which
-    ``holds``."""
-    types = [t for t in afferent_type_codes(lambda k: not k.stretch_drive) if holds(pop.current.for_type(t))]
+def _pressure(kind) -> bool:
+    return not kind.stretch_drive  # a pressure type: its drive is F_A
+
+
+def _types_where(pop, sel, holds, where):
+    """Whether each afferent's type, among those ``where`` selects (as `afferent_type_codes`; None: every type),
+    has resolved current parameters (`TypeCurrentParams`) for which ``holds``."""
+    types = [t for t in afferent_type_codes(where) if holds(pop.current.for_type(t))]
     return _of_type(pop.afferent_type[sel], types)
 
 
@@ -257,8 +260,7 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
     scale = pop.gain[sel] * (1.0 if weights is None else weights)
     noisy = (pop.noise_sigma[sel] > 0) | (pop.noise_cv[sel] > 0) | _excitable(pop, sel)
     # A keyed start phase per (trial, afferent) (`TypeParams.phase`): no unit shares it.
-    noisy |= _of_type(pop.afferent_type[sel], [t for t in afferent_type_codes("phase_spread")
-                                               if pop.current.for_type(t).phase > 0.0])
+    noisy |= _types_where(pop, sel, lambda st: st.phase > 0.0, "phase_spread")
     if not enabled:
         return ConditionPlan(scene.name, scene.n_samples, True, af_constant, weights,
                              np.empty(0, np.int64), np.full(n, -1, np.int64))

@@ -1,9 +1,12 @@
 """Population simulation: schema, exact planning, engines, chunking, seeds, round trip."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 import xarray as xr
 
+from ddmm.models.current_params import CurrentParams
 from ddmm.population import (
     Contact,
     birznieks,
@@ -103,6 +106,19 @@ def test_planned_equals_unplanned(small, kwargs):
     a = simulate(pop, scenes(), engine="direct", quiet=True, **kwargs)
     b = simulate(pop, scenes(), engine="direct", quiet=True, plan=False, **kwargs)
     assert a.identical(b)
+
+
+def test_plan_keeps_stretch_afferents_a_normal_force_drives():
+    """An SA-II without a tonic current but with a normal-force weight fires under a press without shear: the
+    planner must not take it for quiet (and must while the weight is 0)."""
+    current = CurrentParams().with_type("SAII", gain=4.0, normal=0.25)
+    pop = make_population(["SAII"] * 3, [0.0, 90.0, 180.0], "broad", current=current)
+    press = birznieks(None)
+    planned = simulate(pop, press, engine="direct", seed=0, quiet=True)
+    assert planned.sizes["spike"] > 0
+    assert planned.identical(simulate(pop, press, engine="direct", seed=0, quiet=True, plan=False))
+    unpressed = dataclasses.replace(pop, current=current.with_type("SAII", normal=0.0))
+    assert plan_run(unpressed, [press]).conditions[0].n_quiet == 3
 
 
 def test_plan_skips_what_a_scene_does_not_need(fingertip):
