@@ -9,10 +9,15 @@ Modules, in the order a force becomes spikes:
 - `currents`: type-specific filtering of the attenuated force into currents, with
   its parameters (`current_params`), filters (`current_filters`) and keyed
   per-unit and per-trial draws (`variability`);
+- `drive_table`: what each afferent's drive can do given its type and parameters
+  (`DriveTable`): which afferents a run may skip as silent, share or simulate per trial;
 - `neuron`: Izhikevich parameters per type (eqs 4-6);
 - `engines`: the registered engines that integrate the neurons (Brian2, direct);
-- `fused`: the whole pipeline for a block of afferents, as the engines consume it;
-- `pipeline`: the single-afferent convenience (`simulate_afferents`);
+- `fused`: the whole pipeline for a block of afferents, as the engines consume it (the one
+  production path);
+- `pipeline`: the one-NAP convenience on it (`compute_currents`, `simulate_afferents`);
+- `reference_pipeline`: the reference oracle, the same currents stage by stage in numpy
+  (`reference_currents`, `afferent_current`), which the tests hold the production path to;
 - `metrics`, `rng`, `reference_solver`: spike-train metrics, counter-based
   random numbers, and a fine-step RK4 reference for accuracy checks.
 
@@ -23,17 +28,17 @@ nothing heavy until a name is touched.
 from ddmm.utils.lazy import lazy_exports
 
 _WHERE = {
-    "attenuation": ("F_TH", "UNTUNED", "attenuated_force", "attenuation_factor", "shear_magnitude"),
+    "attenuation": ("F_TH", "UNTUNED", "attenuation_factor", "shear_magnitude"),
     "afferent_types": ("AFFERENT_TYPES", "normalize_type", "type_label"),
-    "current_filters": ("filter_force",),
     "current_params": ("CurrentParams",),
     "type_params": ("TypeParams",),
-    "currents": ("afferent_current",),
+    "drive_table": ("DriveTable",),
     "engines": ("ENGINES", "METHODS", "Engine", "NeuronState", "SpikeResult", "get_engine", "integrate",
                 "substeps_for"),
     "metrics": ("CONTACT_THRESHOLD", "direction_index", "spiking_frequency"),
     "nap": ("PROFILES", "boundary_radius", "k_from_selectivity", "selectivity_from_k"),
     "neuron": ("NEURON_PARAMS", "NeuronParams", "resting_state"),
     "pipeline": ("compute_currents", "simulate_afferents"),
+    "reference_pipeline": ("afferent_current", "attenuated_force", "filter_force", "reference_currents"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

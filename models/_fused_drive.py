@@ -3,7 +3,7 @@
 Numba kernels of `ddmm.models.fused` (its front pass calls them per sample
 and group), reading the tables of `ddmm.models._fused_tables`; the
 arithmetic and its order are those of `ddmm.models.attenuation`, so the
-fused path stays bit-identical to the per-stage one.  The helpers take
+fused path stays bit-identical to the reference oracle (`ddmm.models.reference_pipeline`).  The helpers take
 arrays one by one and scalars in scalar-only named tuples (`GroupDrive`,
 `ShearSample`, `DriveConstants`): an inlined helper pays a reference count
 for every array it is handed.
@@ -44,9 +44,9 @@ def _shear(fx, fy, two_fth):
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _sheared(p, fz, mag, w, reading, group):
-    """F_A of a pressure afferent plus its shear-magnitude term (`attenuation.shear_drive`), from its profile
-    AF ``p`` (1 when untuned), in the per-stage path's order of operations; ``group.depth`` as
-    `attenuation.attenuated_force` (``reading``: `DriveConstants`, ``group``: `GroupDrive`)."""
+    """F_A of a pressure afferent plus its shear-magnitude term (`reference_pipeline.shear_drive`), from its profile
+    AF ``p`` (1 when untuned), in the oracle's order of operations; ``group.depth`` as
+    `reference_pipeline.attenuated_force` (``reading``: `DriveConstants`, ``group``: `GroupDrive`)."""
     if not group.tuned:
         fa = fz
     else:

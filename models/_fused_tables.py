@@ -10,6 +10,7 @@ a `FusedTables`; each numba kernel of both passes then takes roughly
 
 from __future__ import annotations
 
+from dataclasses import dataclass, fields
 from typing import NamedTuple
 
 import numpy as np
@@ -19,6 +20,7 @@ from ddmm.models.currents import tonic_current, unit_thresholds
 from ddmm.models.nap import get_profile, tip_radius
 
 __all__ = [
+    "AfferentColumns",
     "DriveConstants",
     "ForceInput",
     "FusedTables",
@@ -27,6 +29,7 @@ __all__ = [
     "ShearSample",
     "afferent_table",
     "group_tables",
+    "rest_state",
     "transducer_runs",
     "type_runs",
 ]
@@ -140,11 +143,11 @@ class GroupDrive(NamedTuple):
     stretch : bool
         SA-II's signed stretch drive instead of F_A.
     shear_g : float
-        Gain of the shear-magnitude term (`attenuation.shear_drive`; 0: none).
+        Gain of the shear-magnitude term (`reference_pipeline.shear_drive`; 0: none).
     opp_s : float
         Its opponent weight.
     depth : float
-        Depth of the normal force's attenuation (`attenuation.attenuated_force`).
+        Depth of the normal force's attenuation (`reference_pipeline.attenuated_force`).
     opponent : float
         A stretch drive's weight of stretch against the preferred direction (`TypeParams.opponent`).
     normal : float
@@ -203,6 +206,91 @@ class DriveConstants(NamedTuple):
     f_th: float
 
 
+@dataclass(frozen=True, kw_only=True)
+class AfferentColumns:
+    """Per-afferent columns of a `FusedPipeline`, one value per afferent each (fields by name only).
+
+    Attributes
+    ----------
+    afferent_type : array_like of str, shape (n_afferents,)
+        Type code per afferent; its length sets the number of afferents.
+    nap : array_like of str
+        NAP profile per afferent (``"none"``: untuned).
+    theta_t : array_like of float
+        Tuning angle in degrees.
+    k : array_like of float
+        Profile sharpness (dimensionless; unused by untuned afferents).
+    scale : array_like of float
+        Multiplier of the stage gain (dimensionless: population gain times
+        receptive-field weight).
+    noise_cv : array_like of float
+        Receptor-noise intensity in sqrt(ms).
+    noise_sigma : array_like of float
+        Additive-noise intensity in mV/ms * sqrt(ms).
+    afferent_id : array_like of int, optional
+        Stable ids keying each afferent's noise (None: 0..n-1).
+    sensitivity : array_like of float, optional
+        Sensitivity (dimensionless, > 0; None: 1): it multiplies the gain and
+        divides the dead zone (`ddmm.models.currents.unit_thresholds`).
+
+    Raises
+    ------
+    ValueError
+        When a column does not hold one value per afferent (the message names it).
+
+    Examples
+    --------
+    >>> AfferentColumns.filled(["SAI", "RAI"], scale=[1.0, 2.0]).k
+    array([0., 0.])
+    """
+
+    afferent_type: np.ndarray
+    nap: np.ndarray
+    theta_t: np.ndarray
+    k: np.ndarray
+    scale: np.ndarray
+    noise_cv: np.ndarray
+    noise_sigma: np.ndarray
+    afferent_id: np.ndarray | None = None
+    sensitivity: np.ndarray | None = None
+
+    def __post_init__(self):
+        n = np.shape(self.afferent_type)
+        if len(n) != 1:
+            raise ValueError(f"AfferentColumns.afferent_type must be 1-D (one type per afferent), got shape {n}")
+        for field in fields(self)[1:]:
+            value = getattr(self, field.name)
+            if value is not None and np.shape(value) != n:
+                raise ValueError(f"AfferentColumns.{field.name} must hold one value per afferent ({n[0]}), "
+                                 f"got shape {np.shape(value)}")
+
+    @classmethod
+    def filled(cls, afferent_type, *, nap=UNTUNED, theta_t=0.0, k=0.0, scale=1.0, noise_cv=0.0, noise_sigma=0.0,
+               afferent_id=None, sensitivity=None) -> AfferentColumns:
+        """The columns of the afferents ``afferent_type``, each other field a scalar (the same for every
+        afferent) or one value per afferent; by default untuned, unscaled and noise-free."""
+        n = len(afferent_type)
+
+        def each(value):  # a scalar: the same for every afferent (a string keeps its own width)
+            return np.full(n, value, dtype=None if isinstance(value, str) else float) if np.ndim(value) == 0 else value
+
+        return cls(afferent_type=afferent_type, nap=each(nap), theta_t=each(theta_t), k=each(k), scale=each(scale),
+                   noise_cv=each(noise_cv), noise_sigma=each(noise_sigma), afferent_id=afferent_id,
+                   sensitivity=sensitivity)
+
+
+def rest_state(n_sections: int, n_afferents: int) -> np.ndarray:
+    """Filter and stage state at rest, the one layout of both paths: rows ``2s`` and ``2s + 1`` hold filter
+    section s, then `_OFFSET`, `_Y1`, `_Y2`, `_SLOW`, `_SMOOTH`, `_DYNC`, `_FASTC`, `_RISEC`; a column per afferent.
+
+    Examples
+    --------
+    >>> rest_state(2, 3).shape
+    (12, 3)
+    """
+    return np.zeros((2 * n_sections + _N_STATE, n_afferents))
+
+
 def type_runs(afferent_type, nap) -> list:
     """(start, stop) of each run of one type, tuned or untuned: the groups of the tables.
 
@@ -233,12 +321,12 @@ def afferent_table(nap, theta_t, k, spans, consts, unit, fs) -> np.ndarray:
         aff_f[_P1:_P5 + 1, rows] = np.array([profile.p1, profile.p2, profile.p3, profile.p4, profile.p5])[:, None]
         aff_f[_TIP, rows] = tip_radius(str(name))
     for (a, b), (stage, *_) in zip(spans, consts):
-        aff_f[_GAIN, a:b] = stage.gain * scale[a:b]  # as `current_core`
+        aff_f[_GAIN, a:b] = stage.gain * scale[a:b]  # as the oracle's `current_core`
         if sens is not None:
             aff_f[_GAIN, a:b] *= sens[a:b]
         aff_f[_DEAD, a:b] = unit_thresholds(stage, None if sens is None else sens[a:b], b - a)
-        aff_f[_TONIC, a:b] = tonic_current(stage, afferent_id[a:b], b - a)  # as `current_core`
-    aff_f[_CV] = noise_cv / np.sqrt(1000.0 / fs)  # as `current_core` and `_receptor_noise`
+        aff_f[_TONIC, a:b] = tonic_current(stage, afferent_id[a:b], b - a)  # as the oracle's `current_core`
+    aff_f[_CV] = noise_cv / np.sqrt(1000.0 / fs)  # as the oracle's `current_core` and `_receptor_noise`
     aff_f[_SIGMA] = noise_sigma / np.sqrt(1000.0 / fs)  # as `noise_current`
     return aff_f
 

@@ -57,7 +57,7 @@ class AfferentType:
         stretch), 1 (velocity) or 2 (acceleration).
     stretch_drive : bool
         Whether its drive is the signed skin-stretch drive
-        (`ddmm.models.attenuation.stretch_drive`: the attenuated shear, with
+        (`ddmm.models.reference_pipeline.stretch_drive`: the attenuated shear, with
         ``SAII.opponent`` and ``SAII.normal``) instead of the attenuated
         force F_A, kept signed through the stage (not rectified); it then
         takes no depth or shear-magnitude term, which shape F_A.

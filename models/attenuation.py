@@ -18,12 +18,12 @@ shear" (docs/model.md §1.5), selected by ``no_shear``:
   forces are.
 
 The physiological presets add a shear-magnitude term to the pressure types'
-F_A (`shear_drive`, ``CurrentParams.<TYPE>.shear``): the same signed
+F_A (``CurrentParams.<TYPE>.shear``; `ddmm.models.reference_pipeline.shear_drive`): the same signed
 stretch, scaled, so tangential force along an afferent's preferred direction
 raises its drive and against it lowers it.
 
 SA-II (Ruffini) afferents are driven by skin stretch, from forces the
-attenuated *shear* (`stretch_drive`); it needs no threshold, since it
+attenuated *shear* (`ddmm.models.reference_pipeline.stretch_drive`); it needs no threshold, since it
 vanishes with F_S.
 
 The conventional model (CMM) is the same pipeline with AF = 1 everywhere:
@@ -36,7 +36,7 @@ import numba as nb
 import numpy as np
 
 from ddmm.models.nap import get_profile, radius_scalar, tip_radius, validate_k
-from ddmm.utils.validation import as_finite_array, as_float_array, check_choice, check_positive, shown
+from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 
 __all__ = [
     "F_TH",
@@ -44,13 +44,10 @@ __all__ = [
     "UNTUNED",
     "shear_magnitude",
     "attenuation_factor",
-    "attenuated_force",
     "af_core",
     "transition_weight",
     "blend_no_shear",
     "profile_factor",
-    "stretch_drive",
-    "shear_drive",
 ]
 
 #: Shear threshold F_TH in newtons below which no direction is defined (eq. 17).
@@ -207,54 +204,6 @@ def blend_no_shear(profile_af, f_s, f_th: float = F_TH) -> np.ndarray:
     return out
 
 
-def stretch_drive(fx, fy, af, opponent: float = 0.0, fz=None, normal: float = 0.0) -> np.ndarray:
-    """SA-II's signed stretch drive ``F_S (AF - opponent (1 - AF))`` in newtons, plus ``normal * F_Z``.
-
-    ``af`` is the profile's AF (shape (n_samples, n_afferents)) on the shear
-    direction; stretch along the preferred direction drives the afferent,
-    stretch against it lowers the drive when ``opponent > 0``.  With
-    ``normal > 0`` (`CurrentParams.SAII.normal`) the normal force ``fz``
-    (N, shape (n_samples,) or (n_samples, n_afferents)) adds to it.
-
-    Examples
-    --------
-    >>> stretch_drive([0.0], [2.0], [[1.0, 0.0]], opponent=0.5).tolist()
-    [[2.0, -1.0]]
-    """
-    f_s = shear_magnitude(fx, fy)
-    af = np.asarray(af, dtype=float)
-    drive = f_s[:, None] * (af - opponent * (1.0 - af))
-    if normal != 0.0:
-        fz = np.asarray(fz, dtype=float)
-        drive = drive + normal * (fz[:, None] if fz.ndim == 1 else fz)
-    return drive
-
-
-def shear_drive(f_a, fx, fy, af, gain: float, opponent: float = 0.0) -> np.ndarray:
-    """A pressure type's drive with its shear-magnitude term, ``max(F_A + gain * stretch_drive, 0)`` (N).
-
-    ``f_a`` is F_A (shape (n_samples, n_afferents)); ``af`` the profile's own
-    AF on the shear direction (`profile_factor`, no threshold), ``gain`` the
-    type's ``CurrentParams.<TYPE>.shear`` and ``opponent`` its
-    ``<TYPE>.opponent_shear``.  With ``gain == 0`` F_A is returned as it is (the
-    paper's drive).  The fused path (`ddmm.models.fused`) runs the same
-    arithmetic in the same order.
-
-    Examples
-    --------
-    >>> shear_drive([[2.0, 0.4]], [0.0], [1.0], [[1.0, 0.2]], 1.0, opponent=1.0).tolist()
-    [[3.0, 0.0]]
-
-    The floor keeps the drive a pressure: a negative drive would read as
-    force to the rectified FA stages.
-    """
-    f_a = np.asarray(f_a, dtype=float)
-    if gain == 0.0:
-        return f_a
-    x = f_a + gain * stretch_drive(fx, fy, af, opponent)
-    return np.where(x > 0.0, x, 0.0)  # floored: shear against the preferred direction silences, never pulls
-
-
 @nb.njit(cache=True, nogil=True, inline="always")
 def profile_value(ux, uy, cos_t, sin_t, k, coeffs, tip):
     """One afferent's profile AF for the unit shear vector (ux, uy): the scalar `_af_kernel` and the
@@ -294,33 +243,14 @@ def af_core(ux, uy, cos_t, sin_t, k, params, tip) -> np.ndarray:
                       per[6])
 
 
-def attenuated_force(fz, af, depth: float = 1.0) -> np.ndarray:
-    """Attenuated force F_A = AF * F_Z in newtons (eq. 18), or ``(1 + depth (AF - 1)) F_Z``.
+_MOVED = ("attenuated_force", "shear_drive", "stretch_drive")  # to the reference oracle, for one release
 
-    Parameters
-    ----------
-    fz : array_like, shape (n_samples,)
-        Normal force in newtons.
-    af : array_like, shape (n_samples, n_afferents)
-        Attenuation factors from `attenuation_factor`.
-    depth : float
-        How deep the attenuation goes, in [0, 1] (``CurrentParams.<TYPE>.depth``;
-        1, the default, is eq. 18; 0 passes F_Z whatever the direction).
 
-    Examples
-    --------
-    >>> attenuated_force([2.0], [[0.5, 1.0]]).tolist()
-    [[1.0, 2.0]]
-    >>> attenuated_force([2.0], [[0.5, 1.0]], depth=0.5).tolist()
-    [[1.5, 2.0]]
-    """
-    fz = as_finite_array(fz, "fz", ndim=1)
-    if isinstance(depth, bool) or not isinstance(depth, (int, float)) or not 0.0 <= depth <= 1.0:
-        raise ValueError(f"depth must be a number in [0, 1] (1: eq. 18), got {shown(depth)}")
-    af = as_float_array(af, "af", ndim=2)
-    if af.shape[0] != fz.size:
-        raise ValueError(f"af must have one row per sample of fz ({fz.size}), got shape {af.shape}")
-    if depth != 1.0:  # the `_fused_drive._sheared` arithmetic, in its order
-        af = 1.0 + depth * (af - 1.0)
-    return af * fz[:, None]
+def __getattr__(name):
+    if name in _MOVED:
+        from ddmm.models import reference_pipeline
+        from ddmm.utils.deprecation import warn_renamed
 
+        warn_renamed(f"ddmm.models.attenuation.{name}", f"ddmm.models.reference_pipeline.{name}")
+        return getattr(reference_pipeline, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

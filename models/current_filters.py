@@ -5,28 +5,26 @@ low-passed by a *causal* Butterworth filter (with RA-II's optional
 high-pass) before its backward differences.  SciPy designs the sections,
 kept on disk by their exact arguments (`lowpass_sos`); `type_filter_constants`
 caches a type's sections and coefficients per (params, type, rate);
-`FilterState` carries a stage's state from one chunk to the next, so chunked
-and whole signals give the same bits; `check_fs` refuses a scene sampled too
-slowly for a type's band.
+`check_fs` refuses a scene sampled too slowly for a type's band.  The
+filters' state between chunks is one array per block of afferents
+(`ddmm.models._fused_tables.rest_state`), so chunked and whole signals give
+the same bits.
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
-from ddmm.models._stage_kernels import ReceptorNoise, StageConstants, TailState, UnitScales, stage_kernel
 from ddmm.models.afferent_types import afferent_type_codes, afferent_type_info
 from ddmm.models.current_params import CurrentParams, TypeCurrentParams
 from ddmm.utils.cache import cache_root
 from ddmm.utils.deprecation import renamed_keyword, warn_renamed
-from ddmm.utils.validation import as_finite_array, check_instance, check_positive
+from ddmm.utils.validation import check_positive
 
-__all__ = ["RAII_FS_FACTOR", "FilterState", "check_fs", "filter_force", "initial_filter_state", "lowpass_sos",
-           "type_filter_constants"]
+__all__ = ["RAII_FS_FACTOR", "check_fs", "lowpass_sos", "type_filter_constants"]
 
 #: A scene must be sampled at least this many times faster than RA-II's cut-off
 #: (its `ddmm.models.afferent_types.AfferentType.fs_per_cutoff`).
@@ -60,43 +58,6 @@ def check_fs(fs: float, params: CurrentParams, afferent_types=None) -> None:
                 f"fs={fs:g} Hz is too slow for {kind}: its band reaches {stage.cutoff_hz:g} Hz, which needs force "
                 f"sampled {need}; resample the scene faster (from_csv(fs=...)) or leave {kind} out (afferent_types=...)"
             )
-
-
-@dataclass(frozen=True)
-class FilterState:
-    """State of a type's causal filter, backward differences and adaptation between chunks.
-
-    The filter runs on the deviation from ``offset`` (the first sample), so a
-    constant force is filtered exactly and gives exactly zero RAI/RAII current.
-
-    Attributes
-    ----------
-    zi : ndarray, shape (n_sections, 2, n_afferents)
-        Second-order-section state of `scipy.signal.sosfilt`.
-    offset : ndarray, shape (n_afferents,)
-        Force subtracted before filtering, in newtons.
-    y1, y2 : ndarray, shape (n_afferents,)
-        The last and second-to-last filtered deviations, in newtons.
-    slow : ndarray, shape (n_afferents,) or None
-        Slow-adaptation low-pass of the filtered deviation (SA-I), in newtons.
-    smooth : ndarray, shape (n_afferents,) or None
-        The current's low-pass state in mV/ms (before the bias).
-    dyn : ndarray, shape (n_afferents,) or None
-        The dynamic response's low-pass of the current in mV/ms (SA-I).
-    fast, rise : ndarray, shape (n_afferents,) or None
-        The fast transient's two low-passes of the current in mV/ms (SA-I):
-        of ``tau_transient_sai_s`` and of half that.
-    """
-
-    zi: np.ndarray
-    offset: np.ndarray
-    y1: np.ndarray
-    y2: np.ndarray
-    slow: np.ndarray | None = None
-    smooth: np.ndarray | None = None
-    dyn: np.ndarray | None = None
-    fast: np.ndarray | None = None
-    rise: np.ndarray | None = None
 
 
 def lowpass_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
@@ -168,64 +129,6 @@ def _highpass_sos(cutoff_hz: float, fs: float) -> np.ndarray:
     return _designed("high", 2, cutoff_hz, fs)
 
 
-def initial_filter_state(f0, fs: float, params: CurrentParams = CurrentParams(), afferent_type: str = "RAI"
-                         ) -> FilterState:
-    """Filter state at rest on a constant input ``f0`` (newtons).
-
-    Starting at steady state means a trace that begins mid-contact produces
-    no spurious derivative at its first sample; a trace that starts at rest
-    (F_A = 0) is unaffected.  ``afferent_type`` selects the stage's filter.
-    """
-    f0 = np.atleast_1d(np.asarray(f0, dtype=float)).copy()
-    sos = _stage_sos(params.for_type(afferent_type), fs)
-    zeros = np.zeros_like(f0)
-    return FilterState(zi=np.zeros((sos.shape[0], 2, f0.size)), offset=f0, y1=zeros, y2=zeros.copy(),
-                       slow=zeros.copy(), smooth=zeros.copy(), dyn=zeros.copy(),
-                       fast=zeros.copy(), rise=zeros.copy())
-
-
-_NO_NORMALS = np.zeros((1, 0))  # no receptor noise: the stage kernel draws nothing
-
-
-def filter_force(f_a, fs: float, params: CurrentParams = CurrentParams(), state=None):
-    """Causally low-pass F_A along time (axis 0) with the shared filter (``cutoff_hz``).
-
-    Parameters
-    ----------
-    f_a : array_like, shape (n_samples, n_afferents)
-        Attenuated force in newtons.
-    fs : float
-        Sample rate in Hz.
-    params : CurrentParams
-        Filter cut-off and order.
-    state : FilterState, optional
-        State carried from the previous chunk; default: at rest on the first
-        sample.
-
-    Returns
-    -------
-    y : ndarray, shape (n_samples, n_afferents)
-        Filtered force in newtons.
-    state : FilterState
-        State after the last sample.
-    """
-    f_a = as_finite_array(f_a, "f_a", ndim=2)
-    fs = check_positive(fs, "fs", "Hz")
-    check_instance(params, "params", CurrentParams, "a CurrentParams")
-    shared = TypeCurrentParams("RAI", 0, params.cutoff_hz, params.filter_order, 0.0, 1.0, 1.0, None, None, 0.0)
-    if state is None:
-        state = initial_filter_state(f_a[0], fs, params)
-    m = f_a.shape[1]
-    zi, y1, y2 = state.zi.copy(), state.y1.copy(), state.y2.copy()
-    slow = np.zeros(m)
-    # The stage kernel with order 0, unit gain and a signed drive returns exactly deviation + offset.
-    tail = TailState(state.offset, y1, y2, slow)
-    y = stage_kernel(_stage_sos(shared, float(fs)), np.ascontiguousarray(f_a), zi, tail,
-                     StageConstants(float(fs), 0, 0.0, 0.0, False, 1.0, True),
-                     UnitScales(np.ones(m), np.zeros(m), np.ones(m)), ReceptorNoise(_NO_NORMALS, False))
-    return y, FilterState(zi=zi, offset=state.offset, y1=y1, y2=y2, slow=slow, smooth=state.smooth)
-
-
 @lru_cache(maxsize=256)
 def type_filter_constants(params: CurrentParams, afferent_type: str, fs: float):
     """(stage, filter sections, adaptation and smoothing coefficients), cached: per call they would
@@ -240,3 +143,19 @@ def stage_constants(params: CurrentParams, afferent_type: str, fs: float):
     """Deprecated name of `type_filter_constants` ("stage" names a scene's interval)."""
     warn_renamed("stage_constants()", "type_filter_constants()")
     return type_filter_constants(params, afferent_type, fs)
+
+
+#: Moved to the reference oracle (`ddmm.models.reference_pipeline`), for one release.
+_MOVED = ("filter_force", "initial_filter_state")
+
+
+def __getattr__(name):
+    if name in _MOVED:
+        from ddmm.models import reference_pipeline
+
+        warn_renamed(f"ddmm.models.current_filters.{name}", f"ddmm.models.reference_pipeline.{name}")
+        return getattr(reference_pipeline, name)
+    if name == "FilterState":
+        raise AttributeError("FilterState was removed: filter state is one array per block of afferents "
+                             "(ddmm.models._fused_tables.rest_state's layout)")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

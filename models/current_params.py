@@ -182,11 +182,9 @@ class CurrentParams:
         if kind.shared_cutoff:
             cutoff = cutoff or self.cutoff_hz  # the paper's shared low-pass before the derivatives
         order = self.filter_order if tp.order is None else tp.order
-        return TypeCurrentParams(kind.code, kind.derivative_order, cutoff, order, tp.adapt, tp.tau_adapt_s, tp.gain,
-                                 self.saturation(kind.code), tp.i_max, tp.bias, tp.tau_s, tp.threshold,
-                                 tp.highpass_hz, float(tp.negative_weight), tp.dynamic, tp.tau_dynamic_s, tp.bias_cv,
-                                 tp.fall, tp.shear, tp.opponent_shear, float(tp.depth), float(tp.transient),
-                                 float(tp.tau_transient_s), tp.opponent, tp.normal, tp.phase)
+        own = {name: getattr(tp, name) for name in TYPE_FIELDS}
+        own.update(cutoff_hz=cutoff, order=order, i_sat=self.saturation(kind.code))
+        return TypeCurrentParams(afferent_type=kind.code, derivative=kind.derivative_order, **own)
 
     def flat(self) -> dict:
         """Every parameter as flat ``{name: value}``: the shared fields, then ``<code>_<field>`` of every
@@ -249,85 +247,34 @@ def _apply_legacy(table: dict, name: str, value) -> None:
         raise type(exc)(name + message[len(field):] if message.startswith(field) else message) from None
 
 
-@dataclass(frozen=True)
-class TypeCurrentParams:
-    """One type's current parameters, resolved from `CurrentParams` (see `CurrentParams.for_type`).
+@dataclass(frozen=True, kw_only=True)
+class TypeCurrentParams(TypeParams):
+    """One type's `TypeParams` resolved against `CurrentParams` and its registry entry (`CurrentParams.for_type`).
+
+    Every field of `TypeParams`, with three resolved: ``cutoff_hz`` (the
+    shared ``CurrentParams.cutoff_hz`` for a `AfferentType.shared_cutoff`
+    type without its own; None: unfiltered), ``order`` (an int: the shared
+    ``CurrentParams.filter_order`` when the type sets none) and ``i_sat``
+    (`CurrentParams.saturation`; None: no log compression); and two from
+    the type:
 
     Attributes
     ----------
     afferent_type : str
+        The type's code.
     derivative : int
-        0 (force or stretch), 1 (velocity) or 2 (acceleration).
-    cutoff_hz : float or None
-        Low-pass cut-off in Hz (None: no filter).
-    order : int
-        Low-pass order.
-    adapt, tau_adapt_s : float
-        Slow-adaptation depth (dimensionless) and time constant (s).
-    gain : float
-        Gain from the drive to mV/ms.
-    i_sat, i_max : float or None
-        Log-compression scale and saturation bound, mV/ms.
-    bias : float
-        Tonic current in mV/ms.
-    tau_s : float or None
-        Time constant of the current's low-pass in s.
-    threshold : float
-        Dead zone of the rectified drive (RA-I's velocity threshold, N/s).
-    highpass_hz : float or None
-        Cut-off of a 2nd-order high-pass in the filter cascade (RA-II), Hz.
-    negative_weight : float
-        Weight of the derivative's negative half-wave when it is rectified
-        (1.0: the absolute value; dimensionless).
-    dynamic, tau_dynamic_s : float
-        Depth (dimensionless) and time constant (s) of the current-level
-        dynamic response (SA-I's ``dynamic_sai``).
-    bias_cv : float
-        Spread of the tonic current across units (SA-II's ``bias_cv_saii``).
-    fall : float
-        Lasting adaptation of the current (SA-I's ``fall_sai``).
-    shear : float
-        Gain of the shear-magnitude term added to F_A (dimensionless; 0: none).
-    opponent_shear : float
-        How much shear against the preferred direction lowers that term (dimensionless).
-    depth : float
-        Depth of the NAP's attenuation of the normal force, in [0, 1] (1: the paper's F_A).
-    transient, tau_transient_s : float
-        Depth (dimensionless) and time constant (s) of the fast transient on
-        the current (SA-I's ``transient_sai``).
-    opponent, normal : float
-        A stretch-drive type's opposing-stretch weight and normal-force
-        weight (dimensionless, `TypeParams.opponent`, `TypeParams.normal`).
-    phase : float
-        Spread of a phase-spread type's start phases, in [0, 1] (`TypeParams.phase`).
+        0 (force or stretch), 1 (velocity) or 2 (acceleration): its
+        `AfferentType.derivative_order`.
+
+    Examples
+    --------
+    >>> st = CurrentParams().for_type("RAI")
+    >>> st.derivative, st.cutoff_hz, st.order
+    (1, 20.0, 2)
     """
 
     afferent_type: str
-    derivative: int
-    cutoff_hz: float | None
-    order: int
-    adapt: float
-    tau_adapt_s: float
-    gain: float
-    i_sat: float | None
-    i_max: float | None
-    bias: float
-    tau_s: float | None = None
-    threshold: float = 0.0
-    highpass_hz: float | None = None
-    negative_weight: float = 1.0
-    dynamic: float = 0.0
-    tau_dynamic_s: float = 1.0
-    bias_cv: float = 0.0
-    fall: float = 0.0
-    shear: float = 0.0
-    opponent_shear: float = 0.0
-    depth: float = 1.0
-    transient: float = 0.0
-    tau_transient_s: float = 0.05
-    opponent: float = 0.0
-    normal: float = 0.0
-    phase: float = 0.0
+    derivative: int = 0
 
     @cached_property  # read on every streamed push: looked up once per stage
     def signed(self) -> bool:

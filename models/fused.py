@@ -1,9 +1,12 @@
-"""The pipeline from force to spikes fused into two numba passes over samples (the streaming hot path).
+"""The one production path from force to spikes: two numba passes over samples (`FusedPipeline`).
 
-The per-stage functions (`ddmm.models.attenuation`, `ddmm.models.currents`,
-`ddmm.models.engines`) stay the definition of the model.  `FusedPipeline` runs the
-same arithmetic, sample by sample, with every per-call constant packed once
-into typed tables (`ddmm.models._fused_tables.FusedTables`):
+`simulate`, the streaming encoder, `compute_currents`, the paper's
+reproductions and the calibration all run on it.  The model is described in
+`ddmm.models.attenuation` and `ddmm.models.currents`, and computed stage by
+stage in the reference oracle (`ddmm.models.reference_pipeline`).
+`FusedPipeline` runs the same arithmetic, sample by sample, with every
+per-call constant packed once into typed tables
+(`ddmm.models._fused_tables.FusedTables`, built from an `AfferentColumns`):
 
 1. **front** (one numba pass): shear magnitude and direction, each
    afferent's profile AF (`attenuation.profile_value`), the no-shear
@@ -28,10 +31,12 @@ For the streaming encoder's large populations, the front pass also runs on
 afferent ranges in parallel (`_front_parts`): afferents are independent, so
 the bits are the same.
 
-Because the scalar helpers are the very functions the per-stage kernels
+Because the scalar helpers are the very functions the oracle's kernels
 call, and every operation keeps their order, the result is bit-identical to
-the stage-by-stage path (``tests/population/test_stream.py`` holds the
-streaming encoder, which runs on this, to the offline `simulate`).
+the oracle's (``tests/models/test_reference_pipeline.py``, ``tests/models/test_fused.py``);
+``tests/population/test_stream.py`` holds the streaming encoder, which runs
+on this chunk by chunk, to the offline `simulate`.  Filter state has one
+layout (`ddmm.models._fused_tables.rest_state`), the oracle's too.
 """
 
 from __future__ import annotations
@@ -49,6 +54,7 @@ from ddmm.models._fused_drive import (
     shared_drive,
 )
 from ddmm.models._fused_tables import (
+    AfferentColumns,
     _ADAPT,
     _ALPHA_ADAPT,
     _ALPHA_DYN,
@@ -64,7 +70,6 @@ from ddmm.models._fused_tables import (
     _FALL,
     _FASTC,
     _GAIN,
-    _N_STATE,
     _NEGATIVE,
     _NO_FORCES,
     _NO_SITES,
@@ -101,6 +106,7 @@ from ddmm.models._fused_tables import (
     NoiseKey,
     afferent_table,
     group_tables,
+    rest_state,
     transducer_runs,
     type_runs,
 )
@@ -116,13 +122,14 @@ from ddmm.models._stage_kernels import (
     transduce_inplace,
 )
 from ddmm.models.afferent_types import type_mask
-from ddmm.models.attenuation import UNTUNED
+from ddmm.models.attenuation import F_TH, NO_SHEAR_READINGS, UNTUNED
 from ddmm.models.currents import excitability, initial_phase, type_filter_constants
 from ddmm.models.engines import get_engine
 from ddmm.models.neuron import neuron_arrays, resting_state
 from ddmm.models.rng import normal_row
+from ddmm.utils.validation import check_choice
 
-__all__ = ["FusedPipeline", "mix_forces", "mixing_matrix"]
+__all__ = ["AfferentColumns", "FusedPipeline", "mix_forces", "mixing_matrix"]
 
 #: Rows (samples) of a drive from which the transducers run fused (`transduce_columns`): below, its
 #: per-call set-up costs more than numpy's few passes save (a streaming push is one row).
@@ -257,39 +264,28 @@ class FusedPipeline:
 
     Parameters
     ----------
-    afferent_type, nap : array_like of str, shape (n_afferents,)
-        Type and NAP per afferent (``"none"`` for untuned).
-    theta_t : array_like of float
-        Tuning angles in degrees.
-    k : array_like of float
-        Sharpness (dimensionless).
-    scale : array_like of float
-        Per-afferent multiplier of the stage gain (population gain times
-        receptive-field weight).
-    noise_cv : array_like of float
-        Receptor-noise intensity in sqrt(ms).
-    noise_sigma : array_like of float
-        Additive-noise intensity in mV/ms * sqrt(ms).
+    columns : AfferentColumns
+        The afferents' type, NAP, tuning, gain and noise, one value per afferent.
     params : CurrentParams
     fs : float
         Sample rate in Hz.
     no_shear : {"pass", "block", "smooth"}
+        The reading of AF at or below the shear threshold (`ddmm.models.attenuation`).
     f_th : float
         Shear threshold in newtons.
-    afferent_id : array_like of int, optional
-        Stable ids keying each afferent's noise (default 0..n-1).
     mixing : ndarray, shape (n_sites, n_afferents), optional
         Each afferent's coefficients of the site forces (`mixing_matrix`):
         the pipeline then takes site forces and mixes them in its kernel.
-    neuron : dict, optional
+    neuron_params : dict, optional
         `ddmm.models.neuron.NeuronParams` by type code, overriding
         `NEURON_PARAMS` (both engines integrate with them).
-    sensitivity : array_like of float, optional
-        Each afferent's sensitivity (dimensionless, > 0; default 1): it
-        multiplies the gain and divides the dead zone (`unit_thresholds`).
 
     Attributes
     ----------
+    Columns : type
+        `AfferentColumns`, for callers that hold the pipeline class only.
+    neuron_params : dict
+        The ``neuron_params`` overrides.
     tables : FusedTables
         Every constant of both passes, built once (`ddmm.models._fused_tables`).
     kernel_tables : tuple
@@ -299,17 +295,23 @@ class FusedPipeline:
     Examples
     --------
     >>> from ddmm.models.currents import CurrentParams
-    >>> pipe = FusedPipeline(["SAI"], ["none"], [0.0], [1.0], [1.0], [0.0], [0.0], CurrentParams(), 1000.0, "pass", 0.1)
+    >>> pipe = FusedPipeline(AfferentColumns.filled(["SAI"]), CurrentParams(), 1000.0)
     >>> pipe.currents(np.array([[0.0, 0.0, 2.0]]), pipe.new_state(), False).shape
     (1, 1)
     """
 
-    def __init__(self, afferent_type, nap, theta_t, k, scale, noise_cv, noise_sigma, params, fs, no_shear, f_th,
-                 afferent_id=None, mixing=None, neuron=None, sensitivity=None):
-        afferent_type, nap = np.asarray(afferent_type), np.asarray(nap)
-        self.afferent_type, self._memo, self._neuron_params = afferent_type, {}, None
-        self.neuron = dict(neuron or {})  # `NeuronParams` overrides by type (eqs 4-6 otherwise)
+    def __init__(self, columns: AfferentColumns, params, fs: float, *, no_shear: str = "pass", f_th: float = F_TH,
+                 mixing=None, neuron_params=None):
+        if not isinstance(columns, AfferentColumns):
+            raise TypeError(f"columns must be an AfferentColumns, got {type(columns).__name__}")
+        check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
+        afferent_type, nap, afferent_id = np.asarray(columns.afferent_type), np.asarray(columns.nap), columns.afferent_id
+        self.afferent_type, self._memo, self._neuron_arrays = afferent_type, {}, None
+        self.neuron_params = dict(neuron_params or {})  # `NeuronParams` overrides by type (eqs 4-6 otherwise)
         self.mixing = None if mixing is None else np.ascontiguousarray(mixing, dtype=float)
+        if self.mixing is not None and (self.mixing.ndim != 2 or self.mixing.shape[1] != afferent_type.size):
+            raise ValueError(f"mixing must be (n_sites, {afferent_type.size}), one column per afferent, got shape "
+                             f"{self.mixing.shape}")
         self.afferent_id = np.ascontiguousarray(np.arange(afferent_type.size) if afferent_id is None else afferent_id,
                                                 dtype=np.int64)
         self.n_afferents, self.fs = afferent_type.size, float(fs)
@@ -318,10 +320,10 @@ class FusedPipeline:
         self.phase = np.zeros(self.n_afferents)  # per afferent: its type's start-phase spread (`TypeParams.phase`)
         for (a, b), (stage, *_) in zip(spans, consts):
             self.phase[a:b] = stage.phase
-        noise_cv, noise_sigma = np.asarray(noise_cv, dtype=float), np.asarray(noise_sigma, dtype=float)
-        unit = (np.asarray(scale, dtype=float), None if sensitivity is None else np.asarray(sensitivity, dtype=float),
-                self.afferent_id, noise_cv, noise_sigma)
-        aff_f = afferent_table(nap, theta_t, k, spans, consts, unit, self.fs)
+        noise_cv, noise_sigma = np.asarray(columns.noise_cv, dtype=float), np.asarray(columns.noise_sigma, dtype=float)
+        sensitivity = None if columns.sensitivity is None else np.asarray(columns.sensitivity, dtype=float)
+        unit = (np.asarray(columns.scale, dtype=float), sensitivity, self.afferent_id, noise_cv, noise_sigma)
+        aff_f = afferent_table(nap, columns.theta_t, columns.k, spans, consts, unit, self.fs)
         grp_f, grp_i, sos = group_tables(spans, consts, noise_cv, nap != UNTUNED, self.fs)
         self.rows = 2 * sos.shape[1]
         self.tables = FusedTables(aff_f, grp_f, grp_i, sos, self.fs, no_shear == "smooth",
@@ -335,17 +337,17 @@ class FusedPipeline:
         self.excite_any, self._excite = bool(np.any(self.excite_cv > 0)), (None, None)
         self.transducers, self._plain = transducer_runs(spans, consts)  # numpy's calls cost per call
 
-    def advance(self, forces, state, sample0, key, neuron, *, dt, method, engine, parts=1):
-        """One chunk through the whole pipeline: (afferent, step within the chunk, neuron state after).
+    def advance(self, forces, state, sample0, key, neuron_state, *, dt, method, engine, parts=1):
+        """One chunk through the whole pipeline: (afferent, step within the chunk, `NeuronState` after).
 
         ``forces`` and ``key`` as `currents`; ``sample0`` is the chunk's first
-        sample (0 starts the filters at rest on it); ``neuron`` the
+        sample (0 starts the filters at rest on it); ``neuron_state`` the
         `NeuronState` before (None: at rest, `initial_membrane`).  The engine
         (a name or a `ddmm.models.engines.Engine`) supplies the integrator
         (`Engine.advance`), with the seam's checks; ``parts`` column ranges
         may run in parallel.
         """
-        return get_engine(engine).advance(self, forces, state, sample0, key, neuron, dt=dt, method=method,
+        return get_engine(engine).advance(self, forces, state, sample0, key, neuron_state, dt=dt, method=method,
                                           parts=parts)
 
     def initial_neuron(self, key, b, d, c):
@@ -361,21 +363,23 @@ class FusedPipeline:
             u[cols] = u[cols] + spread * (np.asarray(d)[cols] if np.ndim(d) else d)
         return v, u
 
-    def neuron_params(self) -> dict:
-        """Per-afferent ``a``, ``b``, ``c``, ``d`` and ``t_ref`` (s) of eqs 4-6, with the ``neuron`` overrides
-        (`ddmm.models.neuron.neuron_arrays`), computed once."""
-        if self._neuron_params is None:
-            self._neuron_params = neuron_arrays(self.afferent_type, self.neuron)
-        return self._neuron_params
+    def neuron_arrays(self) -> dict:
+        """Per-afferent ``a``, ``b``, ``c``, ``d`` and ``t_ref`` (s) of eqs 4-6, with the `neuron_params`
+        overrides (`ddmm.models.neuron.neuron_arrays`), computed once."""
+        if self._neuron_arrays is None:
+            self._neuron_arrays = neuron_arrays(self.afferent_type, self.neuron_params)
+        return self._neuron_arrays
 
-    def initial_membrane(self, neuron, key):
-        """(v, u, r) to integrate a chunk from: copies of a `NeuronState` ``neuron`` (its ``r`` None: zeros), or
-        for None the state before the first sample (`initial_neuron` with ``key``; no refractory steps)."""
-        if neuron is None:
-            p = self.neuron_params()
+    def initial_membrane(self, neuron_state, key):
+        """(v, u, r) to integrate a chunk from: copies of a `NeuronState` ``neuron_state`` (its ``r`` None:
+        zeros), or for None the state before the first sample (`initial_neuron` with ``key``; no refractory
+        steps)."""
+        if neuron_state is None:
+            p = self.neuron_arrays()
             v, u = self.initial_neuron(key, p["b"], p["d"], p["c"])
             return v, u, np.zeros(v.size)
-        return neuron.v.copy(), neuron.u.copy(), np.zeros(neuron.v.size) if neuron.r is None else neuron.r.copy()
+        v, u, r = neuron_state.v, neuron_state.u, neuron_state.r
+        return v.copy(), u.copy(), np.zeros(v.size) if r is None else r.copy()
 
     def memo(self, key, make):
         """``make()``, computed once per hashable ``key`` for this pipeline: what an engine derives from it
@@ -386,7 +390,7 @@ class FusedPipeline:
 
     def new_state(self) -> np.ndarray:
         """Filter, offset, difference, adaptation, smoothing and dynamic-response state at rest, shape (n_rows, n_afferents)."""
-        return np.zeros((self.rows + _N_STATE, self.n_afferents))
+        return rest_state(self.rows // 2, self.n_afferents)
 
     def noise_key(self, key, sample0) -> NoiseKey:
         """The kernels' `NoiseKey` for a stream ``key`` (None: noise-free) and the chunk's first sample."""
@@ -411,7 +415,7 @@ class FusedPipeline:
         # (numba's cache does not track a cached caller's parallel callee).
         drive = _front(*args) if bounds is None or bounds.size <= 2 else _front_parts(*args, bounds)
         excite = self.excitability(key) if key is not None and self.excite_any else None
-        for cols, stage in self.transducers:  # as `current_core`; a push of a few rows: numpy's passes cost least
+        for cols, stage in self.transducers:  # as the oracle's `current_core`; a push of a few rows: numpy's passes cost least
             if stage.signed or drive.shape[0] < _FUSED_ROWS:
                 transduce_inplace(drive[:, cols], stage, None if excite is None else excite[cols])
             else:

@@ -1,7 +1,10 @@
-"""The DDMM pipeline for a set of afferents: forces -> AF -> F_A -> currents -> spikes.
+"""The DDMM for a set of afferents with one NAP: forces -> AF -> F_A -> currents -> spikes.
 
-This is paper Fig. 3 end to end.  The CMM of Fig. 1 is the same pipeline
-with ``profile="none"`` (AF = 1).
+This is paper Fig. 3 end to end, on the production path
+(`ddmm.models.fused.FusedPipeline`, the path `simulate` and the streaming
+encoder run); `ddmm.models.reference_pipeline` computes the same currents
+stage by stage, as the oracle the tests hold it to.  The CMM of Fig. 1 is
+the same pipeline with ``profile="none"`` (AF = 1).
 """
 
 from __future__ import annotations
@@ -9,18 +12,19 @@ from __future__ import annotations
 import numpy as np
 
 from ddmm.models.afferent_types import afferent_type_codes
-from ddmm.models.attenuation import (
-    F_TH,
-    attenuated_force,
-    attenuation_factor,
-    profile_factor,
-    shear_drive,
-    stretch_drive,
-)
+from ddmm.models.attenuation import F_TH, NO_SHEAR_READINGS, UNTUNED
+from ddmm.models.current_filters import check_fs
 from ddmm.models.current_params import CurrentParams
-from ddmm.models.currents import afferent_current
 from ddmm.models.engines import SpikeResult, integrate
-from ddmm.utils.validation import as_finite_array, check_forces, check_instance, check_positive
+from ddmm.models.fused import AfferentColumns, FusedPipeline
+from ddmm.models.nap import PROFILES, validate_k
+from ddmm.utils.validation import (
+    as_finite_array,
+    check_choice,
+    check_forces,
+    check_instance,
+    check_positive,
+)
 
 __all__ = ["compute_currents", "simulate_afferents"]
 
@@ -49,8 +53,9 @@ def compute_currents(
     fs : float
         Sample rate of the forces in Hz.
     afferent_type : str or sequence of str
-        ``"SAI"``, ``"RAI"``, ``"RAII"`` or ``"SAII"`` per afferent (or one
-        for all).  SA-II is driven by the attenuated shear (skin stretch).
+        A registered type code (``"SAI"``, ``"RAI"``, ``"RAII"``, ``"SAII"``,
+        ...) per afferent, or one for all.  SA-II is driven by the
+        attenuated shear (skin stretch).
     profile : str
         ``"selective"``, ``"broad"``, ``"bipolar"`` or ``"none"`` (CMM).
     theta_t : float or array_like
@@ -67,7 +72,8 @@ def compute_currents(
     Returns
     -------
     current : ndarray, shape (n_samples, n_afferents)
-        Currents in mV/ms.
+        Currents in mV/ms, noise-free: bit for bit those of
+        `ddmm.models.reference_pipeline.reference_currents`.
 
     Examples
     --------
@@ -79,36 +85,44 @@ def compute_currents(
     """
     fx, fy, fz = check_forces(fx, fy, fz)
     fs = check_positive(fs, "fs", "Hz")
+    f_th = check_positive(f_th, "f_th", "N")
+    check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
     check_instance(current_params, "current_params", CurrentParams, "a CurrentParams")
+    theta, types, k = check_afferents(theta_t, afferent_type, profile, k)
+    check_fs(fs, current_params, tuple(sorted(set(types.tolist()))))
+    # No afferent ids here, so no unit has its own tonic spread (`<TYPE>.bias_cv`): each has its type's bias.
+    params = current_params.with_all_types(bias_cv=0.0)
+    columns = AfferentColumns.filled(types, nap=str(profile), theta_t=theta, k=k)
+    pipeline = FusedPipeline(columns, params, fs, no_shear=no_shear, f_th=f_th)
+    return pipeline.currents(np.column_stack([fx, fy, fz]), pipeline.new_state(), False)
+
+
+def check_afferents(theta_t, afferent_type, profile: str, k):
+    """(theta_t, afferent_type, k) of afferents sharing one NAP ``profile``, validated, one entry per afferent.
+
+    Raises ``ValueError`` naming ``profile``, ``theta_t``, ``afferent_type`` or ``k``.
+
+    Examples
+    --------
+    >>> theta, types, k = check_afferents([0.0, 90.0], "SAI", "selective", 3.0)
+    >>> types.tolist(), k.tolist()
+    (['SAI', 'SAI'], [3.0, 3.0])
+    """
+    check_choice(profile, "profile", (*PROFILES, UNTUNED))
     theta = np.atleast_1d(as_finite_array(theta_t, "theta_t"))
+    if theta.ndim != 1:
+        raise ValueError(f"theta_t must be a scalar or 1-D, got shape {theta.shape}")
     types = np.broadcast_to(np.asarray(afferent_type, dtype=object), (theta.size,))
     unknown = sorted(set(types) - set(afferent_type_codes()), key=str)
     if unknown:
         raise ValueError(
             f"afferent_type={unknown[0]!r} is unknown; allowed: {', '.join(afferent_type_codes())}"
         )
-    af = attenuation_factor(fx, fy, theta, profile, k, f_th=f_th, no_shear=no_shear)
-    drive = attenuated_force(fz, af)
-    for kind in afferent_type_codes(lambda t: not t.stretch_drive):  # F_A's depth and the presets' shear term
-        cols = np.flatnonzero(types == kind)
-        stage = current_params.for_type(kind)
-        if cols.size and stage.depth != 1.0:
-            drive[:, cols] = attenuated_force(fz, af[:, cols], stage.depth)
-        if cols.size and stage.shear != 0.0:
-            raw = profile_factor(fx, fy, theta[cols], profile, np.broadcast_to(k, theta.shape)[cols])
-            drive[:, cols] = shear_drive(drive[:, cols], fx, fy, raw, stage.shear, stage.opponent_shear)
-    for kind in afferent_type_codes("stretch_drive"):  # SA-II's: the attenuated shear (skin stretch), not F_Z
-        cols = np.flatnonzero(types == kind)
-        if cols.size:
-            stage = current_params.for_type(kind)
-            raw = profile_factor(fx, fy, theta[cols], profile, np.broadcast_to(k, theta.shape)[cols])
-            drive[:, cols] = stretch_drive(fx, fy, raw, stage.opponent, fz, stage.normal)
-    current = np.empty_like(drive)
-    for kind in afferent_type_codes():
-        cols = np.flatnonzero(types == kind)
-        if cols.size:
-            current[:, cols], _ = afferent_current(drive[:, cols], fs, kind, current_params)
-    return current
+    if profile == UNTUNED:
+        k = np.zeros(theta.size)  # the CMM reads no sharpness
+    else:
+        k = np.array(np.broadcast_to(validate_k(k, profile), theta.shape), dtype=float)
+    return theta, types.astype(str), k
 
 
 def simulate_afferents(

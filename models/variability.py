@@ -4,7 +4,7 @@ Every draw comes from the counter-based streams of `ddmm.models.rng`, keyed
 by what it belongs to (the unit alone, or seed, condition, trial and
 afferent), so every engine, chunking and process draws the same numbers.
 The receptor noise itself is drawn by the population runtime and applied in
-the stage (`ddmm.models.currents.current_core`).
+the stage (`ddmm.models.fused`; the oracle's `ddmm.models.reference_pipeline.current_core`).
 """
 
 from __future__ import annotations

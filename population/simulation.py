@@ -18,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ddmm.models.attenuation import F_TH, NO_SHEAR_READINGS
+from ddmm.models.attenuation import NO_SHEAR_READINGS
 from ddmm.models.current_filters import check_fs
 from ddmm.models.engines import METHODS, get_engine, prepare, substeps_for
-from ddmm.models.fused import FusedPipeline, mixing_matrix
+from ddmm.models.fused import AfferentColumns, FusedPipeline, mixing_matrix
 from ddmm.population.anatomy.receptive_fields import frame_theta, local_mixing
 from ddmm.population.runtime.memory import check_run_memory
 from ddmm.population.runtime.noise import noise_key, root_seed
@@ -117,8 +117,10 @@ def block_pipeline(population, fs: float, sites, scale, no_shear: str):
         theta = frame_theta(pop)
         indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, sites, pop.receptive_field)
         mixing = mixing_matrix(indptr, indices, coeff, len(sites))
-    return FusedPipeline(pop.afferent_type, pop.nap, theta, pop.k, scale, pop.noise_cv, pop.noise_sigma, pop.current,
-                         fs, no_shear, F_TH, pop.afferent_id, mixing, pop.neuron, pop.sensitivity)
+    columns = AfferentColumns(afferent_type=pop.afferent_type, nap=pop.nap, theta_t=theta, k=pop.k, scale=scale,
+                              noise_cv=pop.noise_cv, noise_sigma=pop.noise_sigma, afferent_id=pop.afferent_id,
+                              sensitivity=pop.sensitivity)
+    return FusedPipeline(columns, pop.current, fs, no_shear=no_shear, mixing=mixing, neuron_params=pop.neuron)
 
 
 def chunk_forces(scene, sl: slice) -> np.ndarray:
@@ -132,11 +134,11 @@ def _run_trial(job: ChunkJob, pipeline, trial: int, config: SimConfig, progress=
     pop, scene = job.population, job.scene
     key = noise_key(config.seed, job.condition, trial) if job.noisy else None
     substeps = substeps_for(scene.fs, config.dt)
-    state, neuron, afferents, steps = pipeline.new_state(), None, [], []
+    state, neuron_state, afferents, steps = pipeline.new_state(), None, [], []
     for start in range(0, scene.n_samples, config.time_chunk):
         sl = slice(start, min(scene.n_samples, start + config.time_chunk))
-        afferent, step, neuron = pipeline.advance(chunk_forces(scene, sl), state, start, key, neuron,
-                                              dt=config.dt, method=config.method, engine=config.engine)
+        afferent, step, neuron_state = pipeline.advance(chunk_forces(scene, sl), state, start, key, neuron_state,
+                                                        dt=config.dt, method=config.method, engine=config.engine)
         afferents.append(afferent)
         steps.append(step + start * substeps)
         if progress is not None:

@@ -59,9 +59,18 @@ from ddmm.models.current_params import LEGACY_FIELDS, CurrentParams
 from ddmm.models.nap import PROFILE_NAMES
 from ddmm.models.neuron import NeuronParams, check_neuron
 from ddmm.models.type_params import TypeParams
-from ddmm.population.anatomy import hand_map
 from ddmm.population.anatomy.receptive_fields import check_shape
-from ddmm.utils.deprecation import renamed_keyword, warn_renamed
+from ddmm.population.spec_parts import (
+    DEFAULT_SHARPNESS,
+    MAPS,
+    AngleDistribution,
+    MapSpec,
+    Region,
+    SharpnessDistribution,
+)
+from ddmm.population.spec_parts import fail as _fail
+from ddmm.population.spec_parts import finite as _finite
+from ddmm.utils.deprecation import warn_renamed
 from ddmm.utils.validation import check_instance, shown
 
 __all__ = [
@@ -85,184 +94,6 @@ PRESETS = ("fingertip", "hand")
 #: about 241 per cm^2) and below what a process can sample.
 MAX_COUNT = 1_000_000
 MAX_DENSITY_PER_CM2 = 10_000.0
-#: Maps a spec may name in ``[map]``.
-MAPS = ("hand",)
-_ANGLE_KINDS = ("uniform", "von_mises", "fixed", "list")
-_SHARP_KINDS = ("fixed", "uniform", "list")
-
-
-def _fail(key: str, message: str):
-    raise ValueError(f"{key}: {message}")
-
-
-def _finite(key: str, value, *, positive=False, nonneg=False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        _fail(key, f"must be a number, got {shown(value)}")
-    value = float(value)
-    if not math.isfinite(value) or (positive and value <= 0) or (nonneg and value < 0):
-        need = "> 0" if positive else ">= 0" if nonneg else "finite"
-        _fail(key, f"must be {need}, got {shown(value)}")
-    return value
-
-
-@dataclass(frozen=True)
-class AngleDistribution:
-    """Distribution of tuning angles theta_T (degrees).
-
-    Attributes
-    ----------
-    distribution : {"uniform", "von_mises", "fixed", "list"}
-        Uniform on the circle; a von Mises mixture (``mean_deg`` may list
-        several means, with ``weights``); one fixed angle (``value_deg``); or
-        an explicit list cycled over the afferents (``values_deg``).
-    mean_deg : tuple of float
-        Von Mises mean(s) in degrees.
-    kappa : float
-        Von Mises concentration (dimensionless, >= 0; 0 is uniform).
-    weights : tuple of float
-        Mixture weights (default equal).
-    value_deg : float
-        The fixed angle.
-    values_deg : tuple of float
-        The explicit angles.
-    """
-
-    distribution: str = "uniform"
-    mean_deg: tuple = (0.0,)
-    kappa: float = 0.0
-    weights: tuple = ()
-    value_deg: float = 0.0
-    values_deg: tuple = ()
-
-    def __post_init__(self):
-        key = "theta_t"
-        if self.distribution not in _ANGLE_KINDS:
-            _fail(f"{key}.distribution", f"unknown distribution {self.distribution!r}; allowed: {', '.join(_ANGLE_KINDS)}")
-        means = self.mean_deg if isinstance(self.mean_deg, (tuple, list)) else (self.mean_deg,)
-        object.__setattr__(self, "mean_deg", tuple(_finite(f"{key}.mean_deg", m) for m in means))
-        _finite(f"{key}.kappa", self.kappa, nonneg=True)
-        weights = tuple(_finite(f"{key}.weights", w, nonneg=True) for w in self.weights)
-        if weights and (len(weights) != len(self.mean_deg) or not math.isclose(sum(weights), 1.0, abs_tol=1e-6)):
-            _fail(f"{key}.weights", f"need one weight per mean, summing to 1; got {weights}")
-        object.__setattr__(self, "weights", weights)
-        _finite(f"{key}.value_deg", self.value_deg)
-        object.__setattr__(self, "values_deg", tuple(_finite(f"{key}.values_deg", v) for v in self.values_deg))
-        if self.distribution == "list" and not self.values_deg:
-            _fail(f"{key}.values_deg", "a list distribution needs at least one angle")
-
-
-@dataclass(frozen=True)
-class SharpnessDistribution:
-    """Distribution of NAP sharpness, given as theta_A (degrees) or as k.
-
-    Attributes
-    ----------
-    distribution : {"fixed", "uniform", "list"}
-        One value, uniform on [low, high], or an explicit list cycled.
-    of : {"theta_a", "k"}
-        Whether the numbers are selectivity ranges theta_A in degrees
-        (converted by eq. 12) or sharpness k.
-    value, low, high : float
-        Parameters of the fixed and uniform forms.
-    values : tuple of float
-        The explicit values.
-    """
-
-    distribution: str = "fixed"
-    of: str = "k"
-    value: float = 3.0
-    low: float = 0.0
-    high: float = 0.0
-    values: tuple = ()
-
-    def __post_init__(self):
-        if self.distribution not in _SHARP_KINDS:
-            _fail("sharpness.distribution", f"unknown distribution {self.distribution!r}; allowed: {', '.join(_SHARP_KINDS)}")
-        if self.of not in ("theta_a", "k"):
-            _fail("sharpness.of", f"must be 'theta_a' or 'k', got {self.of!r}")
-        for name in ("value", "low", "high"):
-            _finite(f"sharpness.{name}", getattr(self, name))
-        object.__setattr__(self, "values", tuple(_finite("sharpness.values", v) for v in self.values))
-        if self.distribution == "uniform" and not self.low < self.high:
-            _fail("sharpness", f"uniform needs low < high, got low={shown(self.low)}, high={shown(self.high)}")
-        if self.distribution == "list" and not self.values:
-            _fail("sharpness.values", "a list distribution needs at least one value")
-
-
-#: Default sharpness per profile: the paper's k = 3 (broad needs k >= 1.8).
-DEFAULT_SHARPNESS = {name: SharpnessDistribution(value=3.0) for name in PROFILE_NAMES}
-
-
-@dataclass(frozen=True)
-class Region:
-    """An ellipse on the fingertip (mm): centre and semi-axes along X (radial) and Y (distal).
-
-    ``name`` optionally labels it with the hand-map region it stands for
-    (``"D2d"`` for the fingertip preset); its afferents then carry that
-    region and its ``frame_deg``, while positions stay in this local frame.
-    """
-
-    center_mm: tuple = (0.0, 0.0)
-    semi_axes_mm: tuple = (7.0, 9.0)
-    name: str = ""
-
-    def __post_init__(self):
-        if not isinstance(self.name, str) or (self.name and self.name not in hand_map.REGIONS):
-            _fail("region.name", f"{self.name!r} is not a hand-map region; allowed: '', {', '.join(hand_map.REGIONS)}")
-        if len(self.center_mm) != 2 or len(self.semi_axes_mm) != 2:
-            _fail("region", "center_mm and semi_axes_mm need two numbers each")
-        object.__setattr__(self, "center_mm", tuple(_finite("region.center_mm", v) for v in self.center_mm))
-        object.__setattr__(self, "semi_axes_mm",
-                           tuple(_finite("region.semi_axes_mm", v, positive=True) for v in self.semi_axes_mm))
-
-    @property
-    def area_cm2(self) -> float:
-        """Area of the ellipse in cm^2."""
-        a, b = self.semi_axes_mm
-        return math.pi * a * b / 100.0
-
-    @property
-    def frame_deg(self) -> float:
-        """Rotation (deg) from the local frame to the hand frame: the named region's, else 0."""
-        return hand_map.REGIONS[self.name].frame_deg if self.name else 0.0
-
-
-@dataclass(frozen=True)
-class MapSpec:
-    """Afferents placed by a map of the hand (`ddmm.population.anatomy.hand_map`).
-
-    Attributes
-    ----------
-    name : {"hand"}
-        The map.
-    regions : tuple of str
-        Regions to populate, in map order whatever the order given (default:
-        every region).
-    """
-
-    name: str = "hand"
-    regions: tuple = ()
-
-    def __post_init__(self):
-        if self.name not in MAPS:
-            _fail("map.name", f"unknown map {self.name!r}; allowed: {', '.join(MAPS)}")
-        if isinstance(self.regions, str) or not isinstance(self.regions, (tuple, list)):
-            _fail("map.regions", f"must be a list of region names, got {self.regions!r}")
-        for name in self.regions:
-            if name not in hand_map.REGIONS:
-                _fail("map.regions", f"{name!r} is not a region of the map; allowed: {', '.join(hand_map.REGIONS)}")
-        object.__setattr__(self, "regions", tuple(n for n in hand_map.REGIONS if n in self.regions))
-
-    def region_names(self) -> tuple:
-        """The regions populated, in map order."""
-        return self.regions or hand_map.region_names()
-
-    @renamed_keyword("types", "afferent_types")
-    def counts(self, afferent_types) -> dict:
-        """Afferents per region and type, {region: {type: count}} (`hand_map.region_counts`)."""
-        return hand_map.region_counts(tuple(afferent_types), self.region_names())
-
-
 #: Largest ``sensitivity_sd``: a q90/q10 threshold ratio of about 600, beyond any reported spread.
 MAX_SENSITIVITY_SD = 2.5
 

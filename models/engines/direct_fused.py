@@ -34,11 +34,11 @@ __all__ = ["advance_fused", "back_and_integrate", "pipeline_spikes"]
 
 
 @nb.njit(cache=True, nogil=True)
-def back_and_integrate(tables, state, noise, current, neuron, mem, integrate):
+def back_and_integrate(tables, state, noise, current, neuron_table, mem, integrate):
     """`ddmm.models.fused._back`, then (if ``integrate``) the direct engine on the current.
 
-    ``tables``, ``state`` and ``noise`` as `_back` takes them; ``neuron`` is
-    the `NeuronTable` and ``mem`` the `Membrane` (updated in place), all as
+    ``tables``, ``state`` and ``noise`` as `_back` takes them; ``neuron_table``
+    is the `NeuronTable` and ``mem`` the `Membrane` (updated in place), all as
     plain tuples from Python (`ddmm.models._fused_tables`).
     Returns spikes, the smallest current (inf for Euler, whose check does
     not read it), whether the state stayed finite and whether a neuron spiked
@@ -46,16 +46,16 @@ def back_and_integrate(tables, state, noise, current, neuron, mem, integrate):
     checks need the full spike lists only then.
     """
     tables, noise = FusedTables(*tables), NoiseKey(*noise)  # plain tuples from Python, named again
-    neuron, mem = NeuronTable(*neuron), Membrane(*mem)
-    lowest = _back(tables, state, noise, current, neuron.method != 0)
+    table, mem = NeuronTable(*neuron_table), Membrane(*mem)
+    lowest = _back(tables, state, noise, current, table.method != 0)
     if not integrate:
         return np.empty(0, np.int64), np.empty(0, np.int64), lowest, True, False
-    idx, stp = integrate_range(current, neuron, mem, 0, mem.v.size)
+    idx, stp = integrate_range(current, table, mem, 0, mem.v.size)
     finite, capped, _ = spike_checks(idx, stp, mem.v, mem.u)
     return idx, stp, lowest, finite, capped
 
 
-def pipeline_spikes(pipeline, forces, state, started, sample0, key, neuron, mem, parts=1):
+def pipeline_spikes(pipeline, forces, state, started, sample0, key, neuron_table, mem, parts=1):
     """Currents, then the direct engine: (current, afferent, step, smallest current, finite, capped).
 
     Parameters
@@ -63,7 +63,7 @@ def pipeline_spikes(pipeline, forces, state, started, sample0, key, neuron, mem,
     pipeline : ddmm.models.fused.FusedPipeline
     forces, state, started, sample0, key
         As `FusedPipeline.currents` takes them (``state`` updated in place).
-    neuron : NeuronTable
+    neuron_table : NeuronTable
         The integrator's constants (`ddmm.models.engines.direct.neuron_table`).
     mem : Membrane
         ``v``, ``u`` and ``r`` (refractory steps left), updated in place.
@@ -78,24 +78,24 @@ def pipeline_spikes(pipeline, forces, state, started, sample0, key, neuron, mem,
     """
     bounds = pipeline.memo(("direct parts", parts), lambda: part_bounds(pipeline.n_afferents, parts))
     current = pipeline.drive(forces, state, started, sample0, key, bounds)
-    serial, neuron, mem = bounds.size <= 2, tuple(neuron), tuple(mem)  # plain tuples: numba types them in C
-    out = back_and_integrate(pipeline.kernel_tables, state, tuple(pipeline.noise_key(key, sample0)), current, neuron,
+    serial, table, mem = bounds.size <= 2, tuple(neuron_table), tuple(mem)  # plain tuples: numba types them in C
+    out = back_and_integrate(pipeline.kernel_tables, state, tuple(pipeline.noise_key(key, sample0)), current, table,
                              mem, serial)
     if not serial:  # from Python, as the front's parallel kernel
-        idx, stp = integrate_parts(current, neuron, mem, bounds)
+        idx, stp = integrate_parts(current, table, mem, bounds)
         out = (idx, stp, out[2], *spike_checks(idx, stp, mem[0], mem[1])[:2])
     return (current, *out)
 
 
-def advance_fused(pipeline, forces, state, sample0, key, neuron, *, dt, method, parts=1):
+def advance_fused(pipeline, forces, state, sample0, key, neuron_state, *, dt, method, parts=1):
     """`ddmm.models.engines.registry.DirectEngine.advance`: one chunk of ``pipeline`` with the seam's checks.
 
     Arguments as `FusedPipeline.advance`; returns (afferent, step within
     the chunk, `NeuronState` after).
     """
     table = pipeline.memo(("direct", float(dt), method),
-                          lambda: neuron_table(pipeline.neuron_params(), substeps_for(pipeline.fs, dt), dt, method))
-    mem = Membrane(*pipeline.initial_membrane(neuron, key))
+                          lambda: neuron_table(pipeline.neuron_arrays(), substeps_for(pipeline.fs, dt), dt, method))
+    mem = Membrane(*pipeline.initial_membrane(neuron_state, key))
     current, afferent, step, lowest, finite, capped = pipeline_spikes(pipeline, forces, state, sample0 > 0, sample0,
                                                                       key, table, mem, parts)
     if method != "euler":

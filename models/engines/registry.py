@@ -64,7 +64,7 @@ class Engine:
         """
         raise NotImplementedError
 
-    def advance(self, pipeline, forces, state, sample0, key, neuron, *, dt, method, parts=1):
+    def advance(self, pipeline, forces, state, sample0, key, neuron_state, *, dt, method, parts=1):
         """One chunk of a `ddmm.models.fused.FusedPipeline` on this engine: (afferent, step, `NeuronState` after).
 
         Parameters
@@ -72,7 +72,7 @@ class Engine:
         pipeline : ddmm.models.fused.FusedPipeline
         forces, state, sample0, key
             As `FusedPipeline.advance` takes them (``state`` updated in place).
-        neuron : NeuronState or None
+        neuron_state : NeuronState or None
             The state before the chunk (None: `FusedPipeline.initial_membrane`).
         dt : float
             Step in seconds.
@@ -95,8 +95,8 @@ class Engine:
         """
         from ddmm.models.engines import run_checked, substeps_for  # the package imports this module
 
-        substeps, params = substeps_for(pipeline.fs, dt), pipeline.neuron_params()
-        v, u, r = pipeline.initial_membrane(neuron, key)
+        substeps, params = substeps_for(pipeline.fs, dt), pipeline.neuron_arrays()
+        v, u, r = pipeline.initial_membrane(neuron_state, key)
         current = pipeline.currents(forces, state, sample0 > 0, sample0, key)
         res = run_checked(current, substeps, dt, params, v, u, self, method, r, stacklevel=5)
         return res.afferent, res.step, res.state
@@ -132,12 +132,12 @@ class DirectEngine(Engine):
 
         return run_direct(current, substeps, dt, params, v, u, r, method=method, v_peak=v_peak, v_floor=v_floor)
 
-    def advance(self, pipeline, forces, state, sample0, key, neuron, *, dt, method, parts=1):
+    def advance(self, pipeline, forces, state, sample0, key, neuron_state, *, dt, method, parts=1):
         """The pipeline's back pass and the neurons in one numba call (`ddmm.models.engines.direct_fused`),
         ``parts`` column ranges in parallel."""
         from .direct_fused import advance_fused
 
-        return advance_fused(pipeline, forces, state, sample0, key, neuron, dt=dt, method=method, parts=parts)
+        return advance_fused(pipeline, forces, state, sample0, key, neuron_state, dt=dt, method=method, parts=parts)
 
 
 class Brian2Engine(Engine):

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.models.afferent_types import AFFERENT_TYPES as TYPES
+from ddmm.models.afferent_types import afferent_type_codes, normalize_type
 from ddmm.models.metrics import CONTACT_THRESHOLD
 from ddmm.population.neurostim.electrodes import MAX_RATE_HZ
 from ddmm.utils.validation import shown
@@ -105,7 +105,9 @@ class Biomimetic:
     active_sat : float
         Active fraction at which the amplitude reaches its maximum (0-1].
     weights : tuple of (str, float)
-        Weight of each type's spikes in the aggregate rate (>= 0, not all 0).
+        Weight of each named type's spikes in the aggregate rate (>= 0; any
+        spelling of a registered type); a type not named weighs 1, and the
+        registered types' weights may not all be 0.
 
     Examples
     --------
@@ -117,26 +119,34 @@ class Biomimetic:
     rate_sat_hz: float = 100.0
     active_window_s: float = 0.02
     active_sat: float = 0.5
-    weights: tuple = (("SAI", 1.0), ("RAI", 1.0), ("RAII", 1.0), ("SAII", 1.0))
+    weights: tuple = ()
     name = "biomimetic"
     code = 0
 
     def __post_init__(self):
         for field in ("tau_s", "rate_sat_hz", "active_window_s", "active_sat"):
             check_setting(f"{self.name}: {field}", field, getattr(self, field))
+        weights = self._named_weights()
+        if any(not (isinstance(w, (int, float)) and not isinstance(w, bool) and math.isfinite(w) and w >= 0)
+               for w in weights.values()) or not any(weights.get(t, 1.0) for t in afferent_type_codes()):
+            raise ValueError(f"{self.name}: weights must be finite and >= 0, not all 0 over "
+                             f"{', '.join(afferent_type_codes())} (no spike would count), got {self.weights!r}")
+
+    def _named_weights(self) -> dict:
+        """The weights by registered type code (a type not named: absent)."""
         try:
-            weights = dict(self.weights)
+            pairs = dict(self.weights)
         except (TypeError, ValueError):
             raise TypeError(f"{self.name}: weights must be (type, weight) pairs, got {self.weights!r}") from None
-        if set(weights) != set(TYPES) or any(not (isinstance(w, (int, float)) and math.isfinite(w) and w >= 0)
-                                             for w in weights.values()) or not any(weights.values()):
-            raise ValueError(f"{self.name}: weights must give a finite weight >= 0 to each of {', '.join(TYPES)}, "
-                             f"not all 0 (no spike would count), got {self.weights!r}")
+        return {normalize_type(t, f"{self.name}: weights"): w for t, w in pairs.items()}
 
     def type_weights(self, afferent_type) -> np.ndarray:
-        """The weight of each afferent's spikes."""
-        weights = dict(self.weights)
-        return np.array([weights[t] for t in np.asarray(afferent_type).astype(str)], dtype=float)
+        """The weight of each afferent's spikes (1 for a type ``weights`` does not name)."""
+        weights, afferent_type = self._named_weights(), np.asarray(afferent_type).astype(str)
+        out = np.ones(afferent_type.shape)
+        for code, w in weights.items():  # one comparison a named type
+            out[afferent_type == code] = w
+        return out
 
     def params(self) -> np.ndarray:
         """The kernel's parameter vector (`ddmm.population.neurostim.pulses`)."""

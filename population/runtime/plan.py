@@ -9,20 +9,19 @@ condition, what can be skipped without changing a single spike:
   there is no shear at all;
 * spatial weighting when the scene has no contact geometry;
 * afferent types that were not requested;
-* afferents whose current is provably identically zero (no additive noise,
-  and zero normal force or AF = 0 with no shear-magnitude term, or zero
-  receptive-field weight or gain; for SA-II no bias, no shear and, with
-  ``TypeParams.normal``, no normal force): they stay at their resting fixed point
-  and never spike.  Drive-proportional noise (``noise_cv``) is zero with the
-  drive, so it does not stop an afferent from being skipped; nor does the
-  trial excitability (``<TYPE>.excite_cv``), a factor on the current;
+* afferents whose current is provably identically zero: they stay at
+  their resting fixed point and never spike
+  (`ddmm.models.drive_table.DriveTable.quiet` says when, and why);
 * noise generation for afferents without noise;
 * recording variables nobody asked for.
 
 Noiseless afferents with identical parameters share one integration, and
-their trials collapse to one; an afferent with receptor noise or a trial
-excitability is simulated on every trial.  With ``enabled=False`` nothing is skipped (the
-brute-force reference that tests hold the plan to).
+their trials collapse to one; an afferent with receptor noise, a trial
+excitability or a spread start phase is simulated on every trial
+(`ddmm.models.drive_table.DriveTable.varies_by_trial`).  The plan gathers
+the scene's facts; the rules of each type's drive are its `DriveTable`'s.
+With ``enabled=False`` nothing is skipped (the brute-force reference that
+tests hold the plan to).
 """
 
 from __future__ import annotations
@@ -33,7 +32,7 @@ import numpy as np
 
 from ddmm.models.afferent_types import afferent_type_codes, normalize_type, type_mask
 from ddmm.models.attenuation import F_TH, UNTUNED
-from ddmm.models.variability import bias_multiplier
+from ddmm.models.drive_table import DriveTable
 from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
 from ddmm.population.sampling import Population
 from ddmm.population.stimuli.scenes import as_scenes
@@ -175,20 +174,15 @@ def _af_note(cond: ConditionPlan) -> str:
     return f"skipped (no shear that changes AF; AF = {cond.af_constant:g})"
 
 
-def _unit_keys(pop, sel, tuned, scale, local):
+def _unit_keys(pop, sel, table, tuned, scale, local):
     """Rows that identify afferents whose currents are bit-identical (``local``: also their position)."""
-    codes = afferent_type_codes()
-    type_code = np.array([codes.index(t) for t in pop.afferent_type[sel]], dtype=float)
+    type_code = table.type_index.astype(float)
     nap_code = np.where(tuned, np.unique(pop.nap, return_inverse=True)[1][sel], -1).astype(float)
     theta = np.where(tuned, pop.theta_t[sel], 0.0)
     k = np.where(tuned, pop.k[sel], 0.0)
     columns = [type_code, nap_code, theta, k, scale, pop.sensitivity[sel]]  # sensitivity: gain and dead zone
-    spread = {t: cv for t in afferent_type_codes() if (cv := pop.current.for_type(t).bias_cv) > 0.0}
-    if spread:  # each unit's own tonic current (`bias_multiplier`; SA-II's ``SAII.bias_cv``)
-        multiplier = np.ones(sel.size)
-        for t, cv in spread.items():
-            multiplier = np.where(pop.afferent_type[sel] == t, bias_multiplier(cv, pop.afferent_id[sel]), multiplier)
-        columns.append(multiplier)
+    if np.any(table.bias_cv > 0.0):  # each unit's own tonic current (``TypeParams.bias_cv``)
+        columns.append(table.bias_multiplier(pop.afferent_id[sel]))
     if local:  # each afferent feels its own force, a function of its type and position
         columns += [pop.x_mm[sel], pop.y_mm[sel]]
     return np.column_stack(columns)
@@ -199,54 +193,15 @@ def af_threshold(no_shear: str) -> float:
     return 0.0 if no_shear == "smooth" else F_TH
 
 
-def _quiet(pop, sel, scene, scale, computes_af, af_constant):
-    """Afferents whose noise-free current is identically zero (they never leave rest)."""
-    stretch = type_mask(pop.afferent_type[sel], "stretch_drive")
-    blocked = (pop.nap[sel] != UNTUNED) & (not computes_af) & (af_constant == 0.0) & ~_shallow(pop, sel)
-    sheared = _shear_gained(pop, sel) & (scene.max_shear() > 0.0)  # the shear-magnitude term drives them
-    pressed = (scale == 0.0) | ((blocked | (not np.any(scene.fz > 0.0))) & ~sheared)
-    biased = _types_where(pop, sel, lambda st: st.bias != 0.0, None)
-    pressing = _types_where(pop, sel, lambda st: st.normal > 0.0, "stretch_drive")  # `TypeParams.normal`
-    pressing &= bool(np.any(scene.fz != 0.0))
-    stretched = (scale == 0.0) | ((scene.max_shear() == 0.0) & ~pressing)
-    return np.where(stretch, stretched, pressed) & ~biased & (pop.noise_sigma[sel] == 0.0)
+def _quiet(pop, sel, table, scene, scale, computes_af, af_constant):
+    """Afferents whose noise-free current is identically zero (they never leave rest): the scene's facts,
+    judged by the drive's rules (`DriveTable.quiet`)."""
+    return table.quiet(scale, pop.noise_sigma[sel], pop.nap[sel] != UNTUNED, max_shear=scene.max_shear(),
+                       pressed=bool(np.any(scene.fz > 0.0)), loaded=bool(np.any(scene.fz != 0.0)),
+                       computes_af=computes_af, af_constant=af_constant)
 
 
-def _excitable(pop, sel) -> np.ndarray:
-    """Afferents whose type has a trial excitability (``<TYPE>.excite_cv``): their current differs by trial."""
-    return _of_type(pop.afferent_type[sel], [t for t in afferent_type_codes() if pop.current.excite_cv(t) > 0])
-
-
-def _of_type(afferent_type, types) -> np.ndarray:
-    """Whether each afferent's type is one of ``types`` (one comparison a type: np.isin sorts the strings)."""
-    out = np.zeros(afferent_type.shape, dtype=bool)
-    for t in types:
-        out |= afferent_type == t
-    return out
-
-
-def _shallow(pop, sel):
-    """Whether each afferent's type keeps part of its normal drive at AF = 0 (``CurrentParams.<TYPE>.depth`` < 1)."""
-    return _types_where(pop, sel, lambda st: st.depth < 1.0, _pressure)
-
-
-def _shear_gained(pop, sel):
-    """Whether each afferent's drive has a shear-magnitude term (``CurrentParams.<TYPE>.shear`` > 0)."""
-    return _types_where(pop, sel, lambda st: st.shear > 0.0, _pressure)
-
-
-def _pressure(kind) -> bool:
-    return not kind.stretch_drive  # a pressure type: its drive is F_A
-
-
-def _types_where(pop, sel, holds, where):
-    """Whether each afferent's type, among those ``where`` selects (as `afferent_type_codes`; None: every type),
-    has resolved current parameters (`TypeCurrentParams`) for which ``holds``."""
-    types = [t for t in afferent_type_codes(where) if holds(pop.current.for_type(t))]
-    return _of_type(pop.afferent_type[sel], types)
-
-
-def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
+def _condition_plan(pop, sel, table, scene, no_shear, enabled) -> ConditionPlan:
     n, local = sel.size, scene.sites is not None
     # A multi-site scene's local shear is a weighted sum of the sites' and can cross F_TH where none does.
     computes_af = scene.max_shear() > (0.0 if local else af_threshold(no_shear)) or not enabled
@@ -258,20 +213,18 @@ def _condition_plan(pop, sel, scene, no_shear, enabled) -> ConditionPlan:
         weights = (np.ones(n) if scene.contact is None else
                    population_weight(pop, scene.contact)[sel])
     scale = pop.gain[sel] * (1.0 if weights is None else weights)
-    noisy = (pop.noise_sigma[sel] > 0) | (pop.noise_cv[sel] > 0) | _excitable(pop, sel)
-    # A keyed start phase per (trial, afferent) (`TypeParams.phase`): no unit shares it.
-    noisy |= _types_where(pop, sel, lambda st: st.phase > 0.0, "phase_spread")
+    noisy = table.varies_by_trial(pop.noise_sigma[sel], pop.noise_cv[sel])
     if not enabled:
         return ConditionPlan(scene.name, scene.n_samples, True, af_constant, weights,
                              np.empty(0, np.int64), np.full(n, -1, np.int64))
-    quiet = _quiet(pop, sel, scene, scale, computes_af, af_constant)
+    quiet = _quiet(pop, sel, table, scene, scale, computes_af, af_constant)
     deterministic = np.flatnonzero(~noisy & ~quiet)
     member = np.where(quiet, -2, -1).astype(np.int64)
     units = np.empty(0, np.int64)
     if deterministic.size:
-        stretch = type_mask(pop.afferent_type[sel[deterministic]], "stretch_drive") | _shear_gained(pop, sel[deterministic])
-        tuned = (pop.nap[sel[deterministic]] != UNTUNED) & np.where(stretch, scene.max_shear() > 0.0, computes_af)
-        keys = _unit_keys(pop, sel[deterministic], tuned, scale[deterministic], local)
+        kept = table.take(deterministic)
+        tuned = kept.reads_af(pop.nap[sel[deterministic]] != UNTUNED, scene.max_shear(), computes_af)
+        keys = _unit_keys(pop, sel[deterministic], kept, tuned, scale[deterministic], local)
         _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
         order = np.argsort(first)  # units in population order, for readable plans
         rank = np.empty_like(order)
@@ -321,8 +274,9 @@ def make_plan(population, scenes, *, afferent_types=None, trials: int = 1, recor
                  else tuple(normalize_type(t, "afferent_types") for t in afferent_types))
     for r in record:
         check_choice(r, "record", RECORD_CHOICES)
-    wanted = _of_type(population.afferent_type, requested)
+    wanted = type_mask(population.afferent_type, lambda kind: kind.code in requested)
     selected = np.arange(len(population)) if not enabled else np.flatnonzero(wanted)
     keep = np.flatnonzero(wanted[selected])
-    conds = tuple(_condition_plan(population, selected, s, no_shear, enabled) for s in scenes)
+    table = DriveTable.of(population.afferent_type[selected], population.current)  # the drive's rules, once
+    conds = tuple(_condition_plan(population, selected, table, s, no_shear, enabled) for s in scenes)
     return Plan(selected, keep, trials, conds, chunk_size, time_chunk, tuple(record), enabled)

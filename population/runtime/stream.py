@@ -164,7 +164,7 @@ class Encoder:
 
     def reset(self) -> None:
         """Back to the start: filters at rest on the next sample, neurons at rest, noise from sample 0."""
-        self._state, self._neuron, self._samples, self._last_time = self._pipeline.new_state(), None, 0, None
+        self._state, self._neuron_state, self._samples, self._last_time = self._pipeline.new_state(), None, 0, None
         self._conditioner = None if self.conditioning is None else Conditioner(
             self.conditioning, self.fs, self.model_fs, None if self.sites is None else len(self.sites))
 
@@ -261,10 +261,11 @@ class Encoder:
         if n == 0:
             return StreamSpikes(np.empty(0, np.int64), np.empty(0), forces)
         state = self._state.copy()  # committed only if the whole chunk succeeds
-        afferent, step, neuron = self._pipeline.advance(forces, state, self._samples, self._key, self._neuron, dt=self.dt,
-                                                    method=self.method, engine=self._engine, parts=self._parts)
+        afferent, step, neuron_state = self._pipeline.advance(forces, state, self._samples, self._key,
+                                                              self._neuron_state, dt=self.dt, method=self.method,
+                                                              engine=self._engine, parts=self._parts)
         step0 = self._samples * self.substeps
-        self._state, self._neuron = state, neuron
+        self._state, self._neuron_state = state, neuron_state
         self._samples += n
         if times is not None:
             self._last_time = float(times[-1])

@@ -5,7 +5,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from ddmm.models.attenuation import F_TH, attenuated_force, attenuation_factor
+from ddmm.models.attenuation import F_TH, attenuation_factor
+from ddmm.models.reference_pipeline import attenuated_force
 
 PROFILES = ["selective", "broad", "bipolar"]
 
@@ -64,7 +65,8 @@ def test_smooth_af_is_continuous_in_the_shear_vector(angle, theta, k, profile, m
 
 
 def test_stretch_drive_of_sa2_falls_against_its_preferred_direction():
-    from ddmm.models.attenuation import profile_factor, stretch_drive
+    from ddmm.models.attenuation import profile_factor
+    from ddmm.models.reference_pipeline import stretch_drive
     fx, fy = np.zeros(3), np.array([0.0, 1.0, -1.0])
     af = profile_factor(fx, fy, [90.0], "broad", 3.0)
     drive = stretch_drive(fx, fy, af, opponent=0.5)[:, 0]

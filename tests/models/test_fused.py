@@ -7,10 +7,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ddmm.models.attenuation import (UNTUNED, attenuated_force, attenuation_factor, profile_factor, shear_drive,
-                                     stretch_drive)
-from ddmm.models.currents import CurrentParams, current_core, excitability
-from ddmm.models.fused import FusedPipeline
+from ddmm.models.attenuation import UNTUNED, attenuation_factor, profile_factor
+from ddmm.models.currents import CurrentParams, excitability
+from ddmm.models.fused import AfferentColumns, FusedPipeline
+from ddmm.models.reference_pipeline import attenuated_force, current_core, shear_drive, stretch_drive
 from ddmm.models.rng import normals as keyed_normals
 from ddmm.population import load_spec
 
@@ -86,8 +86,9 @@ def test_fused_currents_equal_the_stage_by_stage_path(seed, no_shear, physio, no
     excite = excitability(key, ids, [params.excite_cv(t) for t in TYPES]) if noisy else None
     sensitivity = np.exp(rng.normal(0.0, 0.9, n))  # each unit its own gain and dead zone
     expected = reference(f, params, no_shear, scale, cv, sigma, theta, k, normals, excite, ids, sensitivity)
-    plan = FusedPipeline(TYPES, NAPS, theta, k, scale, cv, sigma, params, FS, no_shear, 0.1, ids,
-                         sensitivity=sensitivity)
+    plan = FusedPipeline(AfferentColumns.filled(TYPES, nap=NAPS, theta_t=theta, k=k, scale=scale, noise_cv=cv,
+                                                      noise_sigma=sigma, afferent_id=ids, sensitivity=sensitivity),
+                         params, FS, no_shear=no_shear)
     state = plan.new_state()
     parts = [plan.currents(f[a:b], state, a > 0, a, key)
              for a, b in ((0, cut), (cut, f.shape[0]))]  # in two chunks: the state carries over
@@ -108,7 +109,8 @@ def test_fused_currents_in_time_slices_equal_the_stage_by_stage_path(monkeypatch
     normals = keyed_normals(9, ids, 0, f.shape[0])
     excite = excitability(9, ids, [PHYSIO.excite_cv(t) for t in TYPES])
     expected = reference(f, PHYSIO, "smooth", scale, cv, sigma, theta, k, normals, excite, ids)
-    plan = FusedPipeline(TYPES, NAPS, theta, k, scale, cv, sigma, PHYSIO, FS, "smooth", 0.1, ids)
+    plan = FusedPipeline(AfferentColumns.filled(TYPES, nap=NAPS, theta_t=theta, k=k, scale=scale, noise_cv=cv,
+                                                      noise_sigma=sigma, afferent_id=ids), PHYSIO, FS, no_shear="smooth")
     np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False, 0, 9), expected)
 
 
@@ -134,13 +136,13 @@ def test_fused_currents_equal_the_reference_on_held_directions(no_shear):
     theta, k, scale = rng.uniform(0, 360, n), rng.uniform(2.0, 5.0, n), np.ones(n)
     f = held_forces(3)
     expected = reference(f, PHYSIO, no_shear, scale, np.zeros(n), np.zeros(n), theta, k, None, ids=np.arange(n))
-    plan = FusedPipeline(TYPES, NAPS, theta, k, scale, np.zeros(n), np.zeros(n), PHYSIO, FS, no_shear, 0.1)
+    plan = FusedPipeline(AfferentColumns.filled(TYPES, nap=NAPS, theta_t=theta, k=k, scale=scale), PHYSIO, FS,
+                         no_shear=no_shear)
     np.testing.assert_array_equal(plan.currents(f, plan.new_state(), False), expected)
 
 
 def test_fused_plan_needs_no_tuned_afferent():
-    plan = FusedPipeline(["RAI", "RAI"], ["none", "none"], [0.0, 0.0], [3.0, 3.0], [1.0, 1.0], [0.0, 0.0], [0.0, 0.0],
-                     PHYSIO, FS, "smooth", 0.1)
+    plan = FusedPipeline(AfferentColumns.filled(["RAI", "RAI"]), PHYSIO, FS, no_shear="smooth")
     f = forces(1)
     drive = shear_drive(np.column_stack([f[:, 2], f[:, 2]]), f[:, 0], f[:, 1], np.ones((f.shape[0], 2)),
                         PHYSIO.shear_rai, PHYSIO.opponent_shear_rai)  # untuned: AF = 1, every direction
@@ -155,8 +157,8 @@ def test_fused_spikes_equal_the_direct_engine(method):
     from ddmm.models.engines.direct_fused import pipeline_spikes
     from ddmm.models.neuron import V_FLOOR, V_PEAK, neuron_arrays, resting_state
 
-    plan = FusedPipeline(TYPES, NAPS, np.linspace(0, 330, len(TYPES)), np.full(len(TYPES), 3.0), np.full(len(TYPES), 2.0),
-                     np.zeros(len(TYPES)), np.zeros(len(TYPES)), PHYSIO, FS, "smooth", 0.1)
+    plan = FusedPipeline(AfferentColumns.filled(TYPES, nap=NAPS, theta_t=np.linspace(0, 330, len(TYPES)), k=3.0,
+                                                      scale=2.0), PHYSIO, FS, no_shear="smooth")
     f = forces(2)
     current = plan.currents(f, plan.new_state(), False)
     res = integrate(current, fs=FS, dt=1e-4, afferent_type=np.array(TYPES), engine="direct", method=method)
@@ -185,8 +187,8 @@ def test_an_engine_that_only_integrates_currents_advances_a_pipeline_as_the_dire
             return get_engine("direct").run(*args, **kwargs)
 
     n = len(TYPES)
-    plan = FusedPipeline(TYPES, NAPS, np.linspace(0, 330, n), np.full(n, 3.0), np.full(n, 2.0), np.full(n, 0.3),
-                         np.full(n, 0.2), PHYSIO, FS, "smooth", 0.1)
+    plan = FusedPipeline(AfferentColumns.filled(TYPES, nap=NAPS, theta_t=np.linspace(0, 330, n), k=3.0, scale=2.0,
+                                                      noise_cv=0.3, noise_sigma=0.2), PHYSIO, FS, no_shear="smooth")
     f, out = forces(3), []
     for engine in (CurrentsOnly(), "direct"):
         state, neuron, afferents, steps = plan.new_state(), None, [], []
@@ -202,3 +204,22 @@ def test_an_engine_that_only_integrates_currents_advances_a_pipeline_as_the_dire
         np.testing.assert_array_equal(x, y)
     for name in ("v", "u", "r"):
         np.testing.assert_array_equal(getattr(out[0][2], name), getattr(out[1][2], name))
+
+
+def test_the_pipeline_takes_a_column_record_and_its_options_by_name():
+    """`FusedPipeline(columns, params, fs, *, no_shear, f_th, mixing, neuron_params)` (issue 41): nothing
+    positional after ``fs``, the columns as one `AfferentColumns`, each of one value per afferent."""
+    columns = AfferentColumns.filled(["SAI", "RAI"])
+    with pytest.raises(TypeError):
+        FusedPipeline(columns, PHYSIO, FS, "smooth")
+    with pytest.raises(TypeError):  # the former column-by-column call
+        FusedPipeline(["SAI"], ["none"], [0.0], [1.0], [1.0], [0.0], [0.0], PHYSIO, FS, "pass", 0.1)
+    with pytest.raises(TypeError, match="AfferentColumns"):
+        FusedPipeline(["SAI", "RAI"], PHYSIO, FS)
+    for field in dataclasses.fields(AfferentColumns)[1:]:
+        with pytest.raises(ValueError, match=rf"AfferentColumns\.{field.name} must hold one value per afferent \(2\)"):
+            dataclasses.replace(columns, **{field.name: np.zeros(3)})
+    with pytest.raises(ValueError, match="mixing"):
+        FusedPipeline(columns, PHYSIO, FS, mixing=np.ones((2, 3)))
+    with pytest.raises(ValueError, match="no_shear"):
+        FusedPipeline(columns, PHYSIO, FS, no_shear="smoth")

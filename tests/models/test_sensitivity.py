@@ -5,7 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ddmm.models.currents import CurrentParams, afferent_current, unit_thresholds
+from ddmm.models.currents import CurrentParams, unit_thresholds
+from ddmm.models.reference_pipeline import afferent_current
 from ddmm.population import load_spec
 
 FS = 1000.0

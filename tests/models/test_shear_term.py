@@ -5,9 +5,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ddmm.models.attenuation import attenuated_force, shear_drive
 from ddmm.models.currents import CurrentParams
 from ddmm.models.pipeline import compute_currents
+from ddmm.models.reference_pipeline import attenuated_force, shear_drive
 from ddmm.population import load_spec, sample_population
 from ddmm.population.simulation import simulate
 from ddmm.population.stimuli.scenes import Scene

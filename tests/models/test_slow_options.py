@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from ddmm.models._stage_kernels import dynamic_kernel
-from ddmm.models.attenuation import stretch_drive
-from ddmm.models.currents import CurrentParams, bias_multiplier, current_core, initial_phase
-from ddmm.models.fused import FusedPipeline
+from ddmm.models.currents import CurrentParams, bias_multiplier, initial_phase
+from ddmm.models.fused import AfferentColumns, FusedPipeline
 from ddmm.models.neuron import resting_state
+from ddmm.models.reference_pipeline import current_core, stretch_drive
 from ddmm.population import load_spec
 
 PHYSIO = load_spec("fingertip").current
@@ -32,7 +32,7 @@ def test_saii_drive_rises_with_normal_force():
     zero = np.zeros(3)
     assert stretch_drive(zero, zero, np.ones((3, 1)), 0.5).ravel().tolist() == [0.0, 0.0, 0.0]
     assert stretch_drive(zero, zero, np.ones((3, 1)), 0.5, fz, 0.25).ravel().tolist() == [0.0, 0.25, 1.0]
-    plan = FusedPipeline(["SAII"], ["none"], [0.0], [0.0], [1.0], [0.0], [0.0], PHYSIO, 1000.0, "smooth", 0.1)
+    plan = FusedPipeline(AfferentColumns.filled(["SAII"]), PHYSIO, 1000.0, no_shear="smooth")
     current = plan.currents(np.column_stack([zero, zero, fz]).repeat(200, axis=0), plan.new_state(), False)
     assert current[399, 0] > current[199, 0] + 0.9 and current[-1, 0] > current[399, 0] + 2.5
 
@@ -42,8 +42,8 @@ def test_tonic_current_is_spread_by_unit_and_the_same_in_every_run():
     m = bias_multiplier(0.25, ids)
     assert np.array_equal(m, bias_multiplier(0.25, ids)) and 0.2 < m.std() < 0.3 and abs(m.mean() - 1.0) < 0.05
     assert np.array_equal(bias_multiplier(0.25, ids[::-1]), m[::-1])  # keyed by id, not by position
-    plan = FusedPipeline(["SAII"] * 4, ["none"] * 4, [0.0] * 4, [0.0] * 4, [1.0] * 4, [0.0] * 4, [0.0] * 4, PHYSIO,
-                         1000.0, "smooth", 0.1, np.arange(4))
+    plan = FusedPipeline(AfferentColumns.filled(["SAII"] * 4, afferent_id=np.arange(4)), PHYSIO, 1000.0,
+                         no_shear="smooth")
     rest = plan.currents(np.zeros((5, 3)), plan.new_state(), False)[-1]
     saii = PHYSIO.type_params("SAII")
     np.testing.assert_array_equal(rest, saii.bias * bias_multiplier(saii.bias_cv, np.arange(4)))
@@ -53,8 +53,7 @@ def test_tonic_current_is_spread_by_unit_and_the_same_in_every_run():
 
 def test_start_phases_are_keyed_by_trial_and_afferent():
     types = ["SAII"] * 3 + ["SAI"]
-    plan = FusedPipeline(types, ["none"] * 4, [0.0] * 4, [0.0] * 4, [1.0] * 4, [0.0] * 4, [0.5] * 4, PHYSIO, 1000.0,
-                         "smooth", 0.1)
+    plan = FusedPipeline(AfferentColumns.filled(types, noise_sigma=0.5), PHYSIO, 1000.0, no_shear="smooth")
     v_rest, u_rest = resting_state(0.2)
     v, u = plan.initial_neuron(7, np.full(4, 0.2), np.full(4, 8.0), np.full(4, -65.0))
     assert np.all(v[:3] == -65.0) and v[3] == v_rest and u[3] == u_rest
@@ -67,7 +66,7 @@ def test_start_phases_are_keyed_by_trial_and_afferent():
 
 def _sai_current(params, force, n=3000, rise=100):
     fz = np.r_[np.linspace(0.0, force, rise), np.full(n - rise, force)]
-    plan = FusedPipeline(["SAI"], ["none"], [0.0], [0.0], [1.0], [0.0], [0.0], params, 1000.0, "smooth", 0.1)
+    plan = FusedPipeline(AfferentColumns.filled(["SAI"]), params, 1000.0, no_shear="smooth")
     return plan.currents(np.column_stack([0 * fz, 0 * fz, fz]), plan.new_state(), False)[:, 0]
 
 

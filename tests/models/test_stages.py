@@ -5,7 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ddmm.models.currents import CurrentParams, afferent_current, check_fs, current_core
+from ddmm.models.currents import CurrentParams, check_fs
+from ddmm.models.reference_pipeline import afferent_current, current_core
 from ddmm.population import load_spec
 
 FS = 1000.0
@@ -20,11 +21,11 @@ def ramp_hold(rate_n_s=10.0, peak=4.0, hold_s=2.0):
 
 
 def test_paper_stage_is_the_default():
-    # The defaults are eqs 1-3 verbatim: SAI = g |F|, with no filter and no state.
+    # The defaults are eqs 1-3 verbatim: SAI = g |F|, with no filter and its state at rest.
     f = np.linspace(0.0, 2.0, 50)[:, None]
     i, state = afferent_current(f, FS, "SAI")
     np.testing.assert_array_equal(i, CurrentParams().type_params("SAI").gain * f)
-    assert state is None
+    assert not state.any()
 
 
 @pytest.mark.parametrize("kind", TYPES)
@@ -142,7 +143,7 @@ def test_the_negative_half_wave_is_weighted(kind):
 
 def _signed_derivative(f, kind):
     """The filtered derivative of the paper's stage with its sign (x 1: no rectification), per sample."""
-    from ddmm.models.currents import filter_force
+    from ddmm.models.reference_pipeline import filter_force
     y, _ = filter_force(f, FS, CurrentParams())
     d = np.diff(np.r_[y[:1], y], axis=0) * FS
     return (d if kind == "RAI" else np.diff(np.r_[d[:1], d], axis=0) * FS)[:, 0]

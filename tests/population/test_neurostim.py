@@ -229,6 +229,8 @@ def test_rate_and_amplitude_rise_with_force_and_a_field_without_contact_is_silen
     (lambda: Biomimetic(active_window_s=5.0), r"active_window_s must be a finite number in \(0, 1\] s, got 5"),
     (lambda: Biomimetic(rate_sat_hz=1e9), r"rate_sat_hz must be a finite number in \(0, 1000\] spikes/s, got 1e\+09"),
     (lambda: Biomimetic(weights=tuple((t, 0.0) for t in ("SAI", "RAI", "RAII", "SAII"))), "not all 0"),
+    (lambda: Biomimetic(weights=(("SA3", 1.0),)), "SA3"),
+    (lambda: Biomimetic(weights=(("SAI", -1.0),)), ">= 0"),
     (lambda: LinearAmplitude(rate_hz=0.001), r"linear-amplitude: rate_hz must be a finite number in \[1, 2000\] Hz"),
     (lambda: LinearAmplitude(force_sat_n=0.05), r"force_sat_n must be a finite number in \(0.05, 500\] N, got 0.05"),
     (lambda: LinearFrequency(force_sat_n=1e15), r"force_sat_n must be a finite number in \(0.05, 500\] N, got 1e\+15"),
@@ -348,3 +350,20 @@ def test_every_limit_holds_on_random_multi_site_scenes(table, rule, seed):
                   quiet=True)
     pulses = stimulation_pulses(ds, table, rule)
     assert check_pulses(pulses) == []
+
+
+def test_biomimetic_weights_name_types_by_any_spelling_and_the_rest_weigh_one():
+    rule = Biomimetic(weights=(("FA-II", 3.0), ("SA-I", 0.0)))
+    assert rule.type_weights(["SAI", "RAI", "RAII", "SAII", "RAII"]).tolist() == [0.0, 1.0, 3.0, 1.0, 3.0]
+    assert Biomimetic().type_weights(["SAI", "SAII"]).tolist() == [1.0, 1.0]
+
+
+def test_a_registered_fifth_type_weighs_one_by_default(monkeypatch):
+    from ddmm.models import afferent_types as registry
+    from ddmm.models.afferent_types import AfferentType, register_afferent_type
+
+    monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))
+    monkeypatch.setattr(registry, "_CODE_OF", dict(registry._CODE_OF))
+    register_afferent_type(AfferentType("TOY", "TOY-I"))
+    assert Biomimetic().type_weights(["TOY", "SAI"]).tolist() == [1.0, 1.0]
+    assert Biomimetic(weights=(("TOY", 2.0),)).type_weights(["TOY"]).tolist() == [2.0]
