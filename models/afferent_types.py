@@ -88,6 +88,10 @@ class AfferentType:
         Its share of the afferents in every region of the hand map
         (`ddmm.population.anatomy.hand_map`); None: not on the map (a
         population spec then gives its count).
+    receptor_depth_mm : float
+        Depth below the skin surface in mm at which its ending reads the
+        skin's stress under indentation (`ddmm.population.stimuli.contact`;
+        docs/model.md, "Skin contact mechanics").
 
     Examples
     --------
@@ -111,6 +115,7 @@ class AfferentType:
     neuron: NeuronParams = field(default_factory=NeuronParams)
     rf_area_mm2: float = 11.0
     density_share: float | None = None
+    receptor_depth_mm: float = 1.0
 
     def __post_init__(self):
         if not isinstance(self.code, str) or not self.code.isalnum() or self.code != self.code.upper():
@@ -128,6 +133,8 @@ class AfferentType:
         for name, cls in (("current", TypeParams), ("neuron", NeuronParams)):
             if not isinstance(getattr(self, name), cls):
                 raise TypeError(f"{name} must be a {cls.__name__}, got {type(getattr(self, name)).__name__}")
+        if not _positive_number(self.receptor_depth_mm) or self.receptor_depth_mm > 10.0:
+            raise ValueError(f"receptor_depth_mm must be a number in (0, 10] mm, got {self.receptor_depth_mm!r}")
         if not _positive_number(self.rf_area_mm2):
             raise ValueError(f"rf_area_mm2 must be a finite number > 0 (mm^2), got {self.rf_area_mm2!r}")
         if self.density_share is not None and not (_positive_number(self.density_share) and self.density_share < 1):
@@ -299,19 +306,23 @@ def normalize_type(afferent_type, name: str = "afferent_type") -> str:
 register_afferent_type(AfferentType(
     "SAI", "SA-I", ("SA1",), "tab:blue", in_paper=True, recorded_by_humans=True,
     current=TypeParams(gain=5.367),  # fitted: CMM SAI SF 47.5 imp/s (Table III)
-    neuron=NeuronParams(b=0.2), rf_area_mm2=11.0, density_share=70.0 / 241.0))
+    neuron=NeuronParams(b=0.2), rf_area_mm2=11.0, density_share=70.0 / 241.0,
+    receptor_depth_mm=0.5))
 register_afferent_type(AfferentType(
     "RAI", "FA-I", ("RA1", "FA1"), "tab:orange", in_paper=True, recorded_by_humans=True, derivative_order=1,
     shared_cutoff=True, current=TypeParams(gain=11.036, tau_adapt_s=0.1),  # fitted: CMM RAI SF 15 imp/s
-    neuron=NeuronParams(b=0.25), rf_area_mm2=12.6, density_share=141.0 / 241.0))
+    neuron=NeuronParams(b=0.25), rf_area_mm2=12.6, density_share=141.0 / 241.0,
+    receptor_depth_mm=0.7))
 register_afferent_type(AfferentType(
     "RAII", "FA-II", ("RA2", "FA2"), "tab:green", in_paper=True, derivative_order=2, shared_cutoff=True,
     fs_per_cutoff=2.5, current=TypeParams(gain=6.162),  # fitted: CMM RAII SF 10 imp/s (Table III)
-    neuron=NeuronParams(b=0.25), rf_area_mm2=10 * 12.6, density_share=21.0 / 241.0))
+    neuron=NeuronParams(b=0.25), rf_area_mm2=10 * 12.6, density_share=21.0 / 241.0,
+    receptor_depth_mm=2.0))
 register_afferent_type(AfferentType(
     "SAII", "SA-II", ("SA2",), "tab:purple", recorded_by_humans=True, stretch_drive=True, log_compression=False,
     phase_spread=True, current=TypeParams(gain=1.0, cutoff_hz=20.0),  # ours: a stretch low-pass at 20 Hz
-    neuron=NeuronParams(b=0.2), rf_area_mm2=5 * 11.0, density_share=9.0 / 241.0))
+    neuron=NeuronParams(b=0.2), rf_area_mm2=5 * 11.0, density_share=9.0 / 241.0,
+    receptor_depth_mm=1.0))
 
 #: The paper's three afferent types (eqs 1-3).
 PAPER_TYPES = afferent_type_codes("in_paper")

@@ -35,7 +35,7 @@ CASES = {
 #: workers, and the streaming encoder's per-chunk latency (raw forces, and through the conditioning stage).
 EXTRA_CASES = ("scale_100k_inprocess", "scale_100k_2workers", "stream_fingertip", "stream_hand",
                "stream_fingertip_conditioned", "hand_5sites_1s_direct", "fingertip_16taxels_1s_direct",
-               "stimulate_hand_16")
+               "hand_vibration_1s_direct", "stimulate_hand_16")
 #: ``--cases lsl``: sample-to-spike latency over Lab Streaming Layer beside the in-process push (extra ddmm[lsl]).
 LSL_CASES = ("lsl_fingertip", "lsl_hand")
 #: ``--cases scaling``: afferents x simulated seconds, each in a fresh process.
@@ -45,7 +45,8 @@ EVENT_CASES = ("events_100hz", "events_1khz", "events_5khz", "events_lsl")
 #: The groups ``--cases`` takes by name (a group is added here, and only here).
 GROUPS = {"scaling": SCALING, "lsl": LSL_CASES, "events": EVENT_CASES}
 #: Multi-site cases and the one-site case each is compared with (same population, same run).
-SITE_BASELINES = {"hand_5sites_1s_direct": "hand_1s_direct", "fingertip_16taxels_1s_direct": "fingertip_1s_direct"}
+SITE_BASELINES = {"hand_5sites_1s_direct": "hand_1s_direct", "fingertip_16taxels_1s_direct": "fingertip_1s_direct",
+                  "hand_vibration_1s_direct": "hand_1s_direct"}
 DT = 1e-4
 
 
@@ -245,14 +246,28 @@ def _site_scene(population: str, sim_s: float):
     return Scene.from_sites(np.repeat(f[:, None, :] / 16, 16, axis=1), sites, base.fs, "taxels16")
 
 
+def _vibration_scene():
+    """A 250 Hz sinusoid of 50 um on a 0.3 mm pre-indentation under a 1 mm probe at the D2 pad, 1 s at 5 kHz
+    (TouchSim's stimulus rate), through the default skin mechanics."""
+    from ddmm.population.anatomy.hand_map import get_region
+    from ddmm.population.stimuli.indentation import indent, probe, sinusoid
+
+    pad = get_region("D2d").center_mm
+    depth = sinusoid(250.0, 0.05, pre_indent_mm=0.3, duration_s=1.0, ramp_s=0.05, fs=5000.0)
+    return indent(probe(pad[0], pad[1], radius_mm=0.5), depth, fs=5000.0, name="vibration_250hz")
+
+
 def _sites_case(name: str) -> dict:
-    """A multi-site case: the whole pipeline on `_site_scene`, after one warm-up."""
+    """A multi-site case: the whole pipeline on `_site_scene` (or an indentation, its mechanics included in
+    the time), after one warm-up."""
     from ddmm.population import sample_population, simulate
 
     population = name.split("_")[0]
-    pop, scene = sample_population(population, rng=0), _site_scene(population, 1.0)
-    simulate(pop, scene, engine="direct", dt=DT, seed=0, quiet=True)
+    make = _vibration_scene if "vibration" in name else (lambda: _site_scene(population, 1.0))
+    pop = sample_population(population, rng=0)
+    simulate(pop, make(), engine="direct", dt=DT, seed=0, quiet=True)
     start = time.perf_counter()
+    scene = make()
     ds = simulate(pop, scene, engine="direct", dt=DT, seed=0, quiet=True)
     wall = time.perf_counter() - start
     return {"name": name, "engine": "direct", "n_afferents": len(pop), "sim_s": 1.0, "dt_ms": DT * 1e3,

@@ -47,6 +47,10 @@ def add_run_options(p, *, out_required: bool) -> None:
     p.add_argument("--theta-r", default=None, metavar="DEG[,DEG...]",
                    help="shear direction(s) in degrees, one condition each ('none': normal only); default 90")
     p.add_argument("--contact", default=None, metavar="X,Y,R", help="contact centre and radius in mm")
+    p.add_argument("--indent", default=None, metavar="KIND[:KEY=VALUE,...]|FILE.toml",
+                   help="an indentation stimulus instead of --scene: ramp, sine, noise or impulse with its settings "
+                        "(e.g. sine:freq_hz=250,amplitude_mm=0.02,pre_indent_mm=0.3,skin=touchsim), or a TOML "
+                        "file of the same keys (docs/user-guide.md, \"Indentation\")")
     add_engine_option(p, "brian2")
     p.add_argument("--dt", type=step_ms, default=None, metavar="MS", help="integration step in ms (default 0.1)")
     p.add_argument("--method", choices=("euler", "rk2", "rk4", "izhikevich2003"), default=None,
@@ -130,9 +134,35 @@ def _array_scene(args):
     return from_long_csv(args.scene, args.sites, conditioning=conditioning, max_force_n=args.max_force)
 
 
+def _indent_scene(args):
+    """The indentation scene of ``--indent`` (named settings or a TOML file); no other scene option applies."""
+    import tomllib
+
+    from ddmm.population.stimuli.indentation_spec import indentation_from_dict, parse_indent_option
+
+    for flag, value in (("--sites", args.sites), ("--theta-r", args.theta_r), ("--contact", args.contact)):
+        if value is not None:
+            raise ValueError(f"{flag} does not apply to an --indent stimulus: its pins and the skin give the forces")
+    if args.scene != "birznieks":
+        raise ValueError(f"give either --indent or --scene, not both (--scene {args.scene!r})")
+    if args.indent.lower().endswith(".toml"):
+        try:
+            with open(args.indent, "rb") as f:
+                table = tomllib.load(f)
+        except OSError as exc:
+            raise ValueError(f"--indent {args.indent!r}: cannot read it ({exc.strerror or exc})") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"--indent {args.indent!r} is not valid TOML: {exc}") from None
+    else:
+        table = parse_indent_option(args.indent)
+    return indentation_from_dict(table)
+
+
 def scenes_from_args(args) -> list:
     """The scenes named by ``--scene``, ``--sites``, ``--theta-r`` and ``--contact``."""
     from ddmm.population import birznieks, press_push_lift, rotating_shear
+    if args.indent is not None:
+        return [_indent_scene(args)]
     array = _array_scene(args)
     if array is not None:
         return [array]

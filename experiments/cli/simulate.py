@@ -25,7 +25,7 @@ def register(sub) -> None:
 def run_simulate(args) -> int:
     from ddmm.population import save_dataset, simulate
     out = check_out_file(args.out, inputs={"--scene": args.scene, "--sites": args.sites,
-                                           "--population": args.population})
+                                           "--population": args.population, "--indent": args.indent})
     pop, scenes = population_from_args(args), scenes_from_args(args)
     start = time.perf_counter()
     ds = simulate(pop, scenes, engine=args.engine, dt=None if args.dt is None else args.dt * 1e-3,

@@ -47,7 +47,7 @@ from __future__ import annotations
 import numpy as np
 
 from ddmm.models.afferent_types import afferent_type_codes, afferent_type_info
-from ddmm.population.stimuli.scenes import Contact, Sites
+from ddmm.population.stimuli.scenes import REFERENCE_AREA_MM2, Contact, Sites
 from ddmm.utils.validation import as_finite_array, check_instance
 
 # RF_AREA_MM2 and RF_SIGMA_MM are views of the registry (the module's __getattr__).
@@ -68,9 +68,6 @@ def __getattr__(name):
         return {code: afferent_type_info(code).rf_sigma_mm for code in afferent_type_codes()}
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
-#: The contact area the model's forces refer to, mm^2: a fingertip pad under a flat surface at 2-4 N,
-#: a disc of 6 mm radius (recalled, not read in a stored source: R).
-REFERENCE_AREA_MM2 = float(np.pi * 6.0 ** 2)
 #: Weights are exactly 0 beyond this many widths outside the contact (the ``"gaussian"`` shape).
 RF_SUPPORT = 3.0
 #: Receptive-field shapes: the Gaussian with a hard support (the package's first form) and the tailed one.
@@ -200,6 +197,9 @@ def local_mixing(x_mm, y_mm, afferent_type, sites, shape: str = "gaussian"):
     >>> indptr.tolist(), coeff.tolist(), cover.tolist()
     ([0, 1, 1], [1.0], [1.0, 0.0])
     """
+    check_instance(sites, "sites", Sites, "a Sites")
+    if sites.spread is not None:  # the sites' own spread (an indentation's mechanics): the fields do not apply
+        return sites.spread.local_mixing(x_mm, y_mm, afferent_type, sites)
     w = site_weights(x_mm, y_mm, afferent_type, sites, shape)
     total = w.sum(axis=1)
     rows, cols = np.nonzero(w)
@@ -219,6 +219,10 @@ def site_coverage(population, sites) -> np.ndarray:
         every region the population covers), naming the site.
     """
     _check_population(population)
+    check_instance(sites, "sites", Sites, "a Sites")
+    if sites.spread is not None:
+        sites.spread.check_reach(population, sites)
+        return local_mixing(population.x_mm, population.y_mm, population.afferent_type, sites)[3]
     w = site_weights(population.x_mm, population.y_mm, population.afferent_type, sites, population.receptive_field)
     dead = np.flatnonzero(~np.any(w > 0.0, axis=0))
     if dead.size:

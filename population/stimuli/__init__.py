@@ -6,7 +6,11 @@
   sign, time base, negative force);
 - `conditioning`: the stage between a recording and the model (resampling,
   noise gate, contact and shear deadband), offline and streaming;
-- `site_scenes`: scenes only force fields can express (torsion, slip, grasp).
+- `site_scenes`: scenes only force fields can express (torsion, slip, grasp);
+- `contact`: the skin's contact mechanics (rigid pins on an elastic half-space: loads, stress at
+  depth, stick and slip);
+- `indentation`: indentation stimuli (probes, bars, pin arrays; ramps, vibration, noise, taps) as
+  scenes through the mechanics, and `indentation_spec` their settings tables (``ddmm simulate --indent``).
 """
 
 from ddmm.utils.lazy import lazy_exports
@@ -17,5 +21,10 @@ _WHERE = {
     "recordings": ("from_csv", "resample_unconditioned", "RecordingBandWarning", "UNITS"),
     "conditioning": ("Conditioning", "Conditioner", "condition_forces"),
     "site_scenes": ("contact_grid", "digit_tip_sites", "grasp", "incipient_slip", "torsion"),
+    "contact": ("SKIN_MODELS", "SkinMechanics", "get_skin_mechanics", "normal_stress", "solve_pin_loads",
+                "stress_kernel", "tangential_loads"),
+    "indentation": ("Pins", "band_noise", "bar_pins", "circle_pins", "impulse", "indent", "pin_array", "probe",
+                    "ramp_hold", "sinusoid"),
+    "indentation_spec": ("indentation_from_dict",),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

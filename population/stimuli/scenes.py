@@ -19,6 +19,7 @@ __all__ = [
     "MAX_FS",
     "MAX_RADIUS_MM",
     "MAX_INCLINATION_DEG",
+    "REFERENCE_AREA_MM2",
     "Contact",
     "Sites",
     "taxel_radius",
@@ -36,6 +37,10 @@ DEFAULT_FS = 1000.0
 MAX_FS = 1.0e6
 MAX_RADIUS_MM = 200.0
 MAX_INCLINATION_DEG = 80.0
+#: The contact area the model's forces refer to, mm^2: a fingertip pad under a flat surface at 2-4 N,
+#: a disc of 6 mm radius (recalled, not read in a stored source: R).  A site's or a pin's traction
+#: counts times this area (`ddmm.population.anatomy.receptive_fields`, `ddmm.population.stimuli.indentation`).
+REFERENCE_AREA_MM2 = float(np.pi * 6.0 ** 2)
 
 
 @dataclass(frozen=True)
@@ -70,6 +75,12 @@ class Sites:
         Region label (e.g. ``"D2d"``), ``""`` when unknown.
     site_id : ndarray of str, shape (n_sites,)
         Unique site names.
+    spread : object, optional
+        How the sites' forces reach the afferents: None for the receptive
+        fields (`ddmm.population.anatomy.receptive_fields.local_mixing`), or an object
+        with that function's ``local_mixing(x_mm, y_mm, afferent_type,
+        sites)`` and ``check_reach(population, sites)``: an indentation's
+        skin mechanics (`ddmm.population.stimuli.indentation.ContactSpread`).
     """
 
     x_mm: np.ndarray
@@ -77,6 +88,7 @@ class Sites:
     radius_mm: np.ndarray
     region: np.ndarray = None
     site_id: np.ndarray = None
+    spread: object = None
 
     def __post_init__(self):
         x = as_finite_array(self.x_mm, "sites x_mm", ndim=1)
@@ -96,6 +108,10 @@ class Sites:
         for name, arr in (("region", region), ("site_id", ids)):
             if arr.shape != (n,):
                 raise ValueError(f"sites {name} must have one entry per site ({n}), got shape {arr.shape}")
+        if self.spread is not None and not (callable(getattr(self.spread, "local_mixing", None))
+                                            and callable(getattr(self.spread, "check_reach", None))):
+            raise TypeError(f"sites spread must be None or have local_mixing and check_reach, got "
+                            f"{type(self.spread).__name__}")
         if len(set(ids.tolist())) != n:
             dup = next(s for s in ids if (ids == s).sum() > 1)
             raise ValueError(f"sites: duplicate site id {dup!r}")
