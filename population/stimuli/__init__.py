@@ -10,7 +10,9 @@
 - `contact`: the skin's contact mechanics (rigid pins on an elastic half-space: loads, stress at
   depth, stick and slip);
 - `indentation`: indentation stimuli (probes, bars, pin arrays; ramps, vibration, noise, taps) as
-  scenes through the mechanics, and `indentation_spec` their settings tables (``ddmm simulate --indent``).
+  scenes through the mechanics, and `indentation_spec` their settings tables (``ddmm simulate --indent``);
+- `surfaces`: textured surfaces (gratings, dot patterns, embossed letters, bitmaps) scanned across the
+  skin, as indentation scenes.
 """
 
 from ddmm.utils.lazy import lazy_exports
@@ -26,5 +28,6 @@ _WHERE = {
     "indentation": ("Pins", "band_noise", "bar_pins", "circle_pins", "impulse", "indent", "pin_array", "probe",
                     "ramp_hold", "sinusoid"),
     "indentation_spec": ("indentation_from_dict",),
+    "surfaces": ("Surface", "dot_pattern", "from_bitmap", "grating", "letters", "min_scan_fs", "scan"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

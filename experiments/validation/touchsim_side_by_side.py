@@ -1,0 +1,129 @@
+"""ddmm beside TouchSim on one named list of indentation stimuli: per-type rates and first-spike times.
+
+The named list (issue 43): a ramp-and-hold on one 1 mm probe at 0.25, 0.5 and 1.0 mm; sinusoids on the
+probe at 5-300 Hz and 0.01, 0.05 and 0.2 mm on a 0.3 mm pre-indentation; a 1 mm grating scanned at 40 mm/s
+(where `ddmm.population.stimuli.surfaces` is present).  ddmm's units are the fingertip preset's nearest units
+of each type, moved to the probe's centre (their own gains, sensitivities and noise), on the default skin;
+TouchSim's are its single models at the same place.  TouchSim's figures come from its own run
+(`experiments/validation/touchsim_responses.py`, in TouchSim's environment), recorded in a JSON file.
+
+Run::
+
+    python -m ddmm.experiments.validation.touchsim_side_by_side --touchsim tests/population/data/touchsim_responses.json
+
+It prints, per stimulus and type, both mean rates (spikes/s), their ratio and both median first-spike times;
+ddmm's responses to displacement are not calibrated yet, so the ratios are measurements, not targets met.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+
+import numpy as np
+
+__all__ = ["PAIRS", "ddmm_responses", "main", "named_list", "touchsim_summary"]
+
+#: ddmm's type for each TouchSim class (TouchSim fits SA1, RA and PC only).
+PAIRS = {"SA1": "SAI", "RA": "RAI", "PC": "RAII"}
+_UNITS = {"SAI": 4, "RAI": 9, "RAII": 4}  # as many as TouchSim has single models of each class
+
+
+def named_list() -> dict:
+    """{name: (depth waveform in mm at 5 kHz, the key of TouchSim's recording)} of the probe stimuli.
+
+    The waveforms are TouchSim's stimuli as its recording describes them: a ramp-and-hold of 1 s with
+    linear 50 ms ramps (`ramp_hold`, the same samples); a sinusoid whose phase runs over
+    ``linspace(0, 2 pi f T, n)`` with linear 50 ms ramps, on a 0.3 mm pre-indentation present from the
+    first sample (a step: the filters start at rest on it, so it makes no onset transient).
+    """
+    from ddmm.population.stimuli.indentation import ramp_hold
+
+    stimuli = {f"ramp_{d:g}mm": (ramp_hold(d, ramp_s=0.05, hold_s=0.9, fs=5000.0), ("ramp", f"d{d:g}"))
+               for d in (0.25, 0.5, 1.0)}
+    n, k = 2500, 250
+    envelope = np.ones(n)
+    envelope[:k], envelope[n - k:] = np.linspace(0.0, 1.0, k), np.linspace(1.0, 0.0, k)
+    for f in (5.0, 10.0, 20.0, 40.0, 80.0, 150.0, 250.0, 300.0):
+        for a in (0.01, 0.05, 0.2):
+            wave = 0.3 + a * np.sin(np.linspace(0.0, 2.0 * np.pi * f * 0.5, n)) * envelope
+            stimuli[f"sine_{f:g}hz_{a:g}mm"] = (wave, ("sine", f"f{f:g}_a{a:g}"))
+    return stimuli
+
+
+def _units():
+    """The fingertip preset's units nearest its centre, ``_UNITS`` of each type, moved to (0, 0)."""
+    from ddmm.population import sample_population
+
+    pop = sample_population("fingertip", rng=0)
+    r = np.hypot(pop.x_mm, pop.y_mm)
+    pick = np.concatenate([np.flatnonzero(pop.afferent_type == t)[np.argsort(r[pop.afferent_type == t])[:n]]
+                           for t, n in _UNITS.items()])
+    sub = pop.select(pick)
+    return dataclasses.replace(sub, x_mm=np.zeros(len(sub)), y_mm=np.zeros(len(sub)))
+
+
+def ddmm_responses(seed: int = 0) -> dict:
+    """{stimulus: {type: {"rate": mean spikes/s, "first_spike_s": median first-spike time or None}}}."""
+    from ddmm.population import simulate
+    from ddmm.population.stimuli.indentation import indent, probe
+
+    units, out = _units(), {}
+    for name, (depth, _) in named_list().items():
+        ds = simulate(units, indent(probe(), depth, fs=5000.0, name=name), engine="direct", seed=seed, quiet=True)
+        out[name] = _summary(ds, depth.size / 5000.0)
+    return out
+
+
+def _summary(ds, duration_s: float) -> dict:
+    counts = ds.spike_count.sum(("condition", "trial")).values
+    summary = {}
+    for kind in _UNITS:
+        mine = np.flatnonzero(ds.afferent_type.values == kind)
+        firsts = [float(ds.spike_time.values[ds.spike_afferent.values == j].min()) for j in mine
+                  if counts[j] > 0]
+        summary[kind] = {"rate": float(counts[mine].mean() / duration_s),
+                         "first_spike_s": float(np.median(firsts)) if firsts else None}
+    return summary
+
+
+def touchsim_summary(recording: dict, key: tuple) -> dict:
+    """{class: {"rate": mean spikes/s, "first_spike_s": median first-spike time or None}} of one recorded
+    TouchSim stimulus (``key``: its group and name in the recording)."""
+    units = recording[key[0]][key[1]]["afferents"]
+    out = {}
+    for cls in PAIRS:
+        mine = [u for u in units if u["class"] == cls]
+        firsts = [u["first_spike_s"] for u in mine if u["first_spike_s"] is not None]
+        out[cls] = {"rate": float(np.mean([u["rate_hz"] for u in mine])),
+                    "first_spike_s": float(np.median(firsts)) if firsts else None}
+    return out
+
+
+def main(argv=None) -> int:
+    """Print the side-by-side table (module docstring)."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--touchsim", required=True, help="TouchSim's recorded responses (JSON)")
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args(argv)
+    with open(args.touchsim) as f:
+        recording = json.load(f)
+    ours = ddmm_responses(args.seed)
+    print("stimulus | type | ddmm imp/s | TouchSim imp/s | ratio | ddmm first spike s | TouchSim first spike s")
+    for name, (_, key) in named_list().items():
+        theirs = touchsim_summary(recording, key)
+        for cls, kind in PAIRS.items():
+            mine, ts = ours[name][kind], theirs[cls]
+            ratio = f"{mine['rate'] / ts['rate']:.2f}" if ts["rate"] else "-"
+            print(f"{name} | {kind} | {mine['rate']:.1f} | {ts['rate']:.1f} | {ratio} | {_s(mine['first_spike_s'])} | "
+                  f"{_s(ts['first_spike_s'])}")
+    return 0
+
+
+def _s(t) -> str:
+    return "-" if t is None else f"{t:.4f}"
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,33 @@
+"""TouchSim's recorded responses (`tests/population/data/touchsim_responses.json`) and the side-by-side script.
+
+The recording was made by `experiments/validation/touchsim_responses.py` in TouchSim's own environment
+(public repository, commit 4ec9f5c); `ddmm.experiments.validation.touchsim_side_by_side` reads it.
+"""
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ddmm.experiments.validation.touchsim_side_by_side import PAIRS, named_list, touchsim_summary
+
+RECORDING = json.loads((Path(__file__).parent / "data" / "touchsim_responses.json").read_text())
+
+
+def test_every_named_stimulus_has_touchsims_response_for_every_class():
+    for name, (depth, key) in named_list().items():
+        summary = touchsim_summary(RECORDING, key)
+        assert set(summary) == set(PAIRS), name
+        assert RECORDING[key[0]][key[1]]["duration_s"] == depth.size / 5000.0, name
+
+
+def test_the_recording_names_touchsims_commit_and_its_single_models():
+    assert RECORDING["touchsim"]["commit"].startswith("4ec9f5c")
+    classes = [u["class"] for u in RECORDING["ramp"]["d0.5"]["afferents"]]
+    assert {c: classes.count(c) for c in PAIRS} == {"SA1": 4, "RA": 9, "PC": 4}
+
+
+def test_touchsim_grows_with_depth_and_pc_follows_250_hz():
+    ramp = [touchsim_summary(RECORDING, ("ramp", f"d{d:g}"))["SA1"]["rate"] for d in (0.25, 0.5, 1.0)]
+    assert np.all(np.diff(ramp) > 0)
+    assert touchsim_summary(RECORDING, ("sine", "f250_a0.05"))["PC"]["rate"] >= 250.0
