@@ -2,7 +2,7 @@
 
 The named list (issue 43): a ramp-and-hold on one 1 mm probe at 0.25, 0.5 and 1.0 mm; sinusoids on the
 probe at 5-300 Hz and 0.01, 0.05 and 0.2 mm on a 0.3 mm pre-indentation; a 1 mm grating scanned at 40 mm/s
-(where `ddmm.population.stimuli.surfaces` is present).  ddmm's units are the fingertip preset's nearest units
+(`grating_scene`).  ddmm's units are the fingertip preset's nearest units
 of each type, moved to the probe's centre (their own gains, sensitivities and noise), on the default skin;
 TouchSim's are its single models at the same place.  TouchSim's figures come from its own run
 (`experiments/validation/touchsim_responses.py`, in TouchSim's environment), recorded in a JSON file.
@@ -23,7 +23,7 @@ import json
 
 import numpy as np
 
-__all__ = ["PAIRS", "ddmm_responses", "main", "named_list", "touchsim_summary"]
+__all__ = ["PAIRS", "ddmm_responses", "grating_scene", "main", "named_list", "touchsim_summary"]
 
 #: ddmm's type for each TouchSim class (TouchSim fits SA1, RA and PC only).
 PAIRS = {"SA1": "SAI", "RA": "RAI", "PC": "RAII"}
@@ -52,20 +52,35 @@ def named_list() -> dict:
     return stimuli
 
 
+def _nearest(pop) -> np.ndarray:
+    """Indices of the ``_UNITS`` units of each type nearest the centre of ``pop``'s frame."""
+    r = np.hypot(pop.x_mm, pop.y_mm)
+    return np.concatenate([np.flatnonzero(pop.afferent_type == t)[np.argsort(r[pop.afferent_type == t])[:n]]
+                           for t, n in _UNITS.items()])
+
+
 def _units():
     """The fingertip preset's units nearest its centre, ``_UNITS`` of each type, moved to (0, 0)."""
     from ddmm.population import sample_population
 
     pop = sample_population("fingertip", rng=0)
-    r = np.hypot(pop.x_mm, pop.y_mm)
-    pick = np.concatenate([np.flatnonzero(pop.afferent_type == t)[np.argsort(r[pop.afferent_type == t])[:n]]
-                           for t, n in _UNITS.items()])
-    sub = pop.select(pick)
+    sub = pop.select(_nearest(pop))
     return dataclasses.replace(sub, x_mm=np.zeros(len(sub)), y_mm=np.zeros(len(sub)))
 
 
+def grating_scene():
+    """The named list's grating: 1 mm period, ridges 0.5 mm wide and high, scanned along +X at 40 mm/s for 0.5 s
+    over a 6 x 6 mm window of 0.2 mm pins, ridges 0.8 mm into the skin, at 5 kHz (TouchSim's recording
+    builds the same grating on the same pin grid)."""
+    from ddmm.population.stimuli.surfaces import grating, scan
+
+    return scan(grating(1.0, 0.5, 0.5), speed_mm_s=40.0, direction_deg=0.0, duration_s=0.5, contact_mm=0.8,
+                window_mm=(6.0, 6.0), pitch_mm=0.2, fs=5000.0, name="grating_40mm_s")
+
+
 def ddmm_responses(seed: int = 0) -> dict:
-    """{stimulus: {type: {"rate": mean spikes/s, "first_spike_s": median first-spike time or None}}}."""
+    """{stimulus: {type: {"rate": mean spikes/s, "first_spike_s": median first-spike time or None, "vs": median
+    vector strength at 40 Hz after 0.1 s (the grating)}}}."""
     from ddmm.population import simulate
     from ddmm.population.stimuli.indentation import indent, probe
 
@@ -73,25 +88,46 @@ def ddmm_responses(seed: int = 0) -> dict:
     for name, (depth, _) in named_list().items():
         ds = simulate(units, indent(probe(), depth, fs=5000.0, name=name), engine="direct", seed=seed, quiet=True)
         out[name] = _summary(ds, depth.size / 5000.0)
+    from ddmm.population import sample_population
+
+    # The grating's window needs skin under every pin, so its units stay where they are in the fingertip.
+    out["grating_40mm_s"] = _grating_summary(sample_population("fingertip", rng=0), seed)
     return out
 
 
-def _summary(ds, duration_s: float) -> dict:
+def _grating_summary(pop, seed: int) -> dict:
+    """The nearest units' responses to the grating, simulated within the population that covers its window."""
+    from ddmm.population import simulate
+
+    window = np.flatnonzero((np.abs(pop.x_mm) <= 4.5) & (np.abs(pop.y_mm) <= 4.5))
+    sub = pop.select(window)
+    ds = simulate(sub, grating_scene(), engine="direct", seed=seed, quiet=True)
+    return _summary(ds, 0.5, vs_hz=40.0, units=_nearest(sub))
+
+
+def _summary(ds, duration_s: float, vs_hz: float | None = None, units=None) -> dict:
+    """Per type: mean rate, median first spike (and median VS at ``vs_hz``) over ``units`` (afferent positions
+    in ``ds``; None: all)."""
     counts = ds.spike_count.sum(("condition", "trial")).values
+    units = np.arange(counts.size) if units is None else np.asarray(units)
     summary = {}
     for kind in _UNITS:
-        mine = np.flatnonzero(ds.afferent_type.values == kind)
-        firsts = [float(ds.spike_time.values[ds.spike_afferent.values == j].min()) for j in mine
-                  if counts[j] > 0]
+        mine = units[ds.afferent_type.values[units] == kind]
+        trains = [ds.spike_time.values[ds.spike_afferent.values == j] for j in mine]
+        firsts = [float(t.min()) for t in trains if t.size]
         summary[kind] = {"rate": float(counts[mine].mean() / duration_s),
                          "first_spike_s": float(np.median(firsts)) if firsts else None}
+        if vs_hz is not None:
+            strengths = [abs(np.mean(np.exp(2j * np.pi * vs_hz * t[t >= 0.1]))) for t in trains
+                         if np.sum(t >= 0.1) >= 5]
+            summary[kind]["vs"] = float(np.median(strengths)) if strengths else None
     return summary
 
 
 def touchsim_summary(recording: dict, key: tuple) -> dict:
     """{class: {"rate": mean spikes/s, "first_spike_s": median first-spike time or None}} of one recorded
     TouchSim stimulus (``key``: its group and name in the recording)."""
-    units = recording[key[0]][key[1]]["afferents"]
+    units = (recording[key[0]] if key[1] is None else recording[key[0]][key[1]])["afferents"]
     out = {}
     for cls in PAIRS:
         mine = [u for u in units if u["class"] == cls]
@@ -111,13 +147,13 @@ def main(argv=None) -> int:
         recording = json.load(f)
     ours = ddmm_responses(args.seed)
     print("stimulus | type | ddmm imp/s | TouchSim imp/s | ratio | ddmm first spike s | TouchSim first spike s")
-    for name, (_, key) in named_list().items():
+    for name, (_, key) in {**named_list(), "grating_40mm_s": (None, ("grating", None))}.items():
         theirs = touchsim_summary(recording, key)
         for cls, kind in PAIRS.items():
             mine, ts = ours[name][kind], theirs[cls]
             ratio = f"{mine['rate'] / ts['rate']:.2f}" if ts["rate"] else "-"
             print(f"{name} | {kind} | {mine['rate']:.1f} | {ts['rate']:.1f} | {ratio} | {_s(mine['first_spike_s'])} | "
-                  f"{_s(ts['first_spike_s'])}")
+                  f"{_s(ts['first_spike_s'])}" + (f" | ddmm VS at 40 Hz {_s(mine['vs'])}" if "vs" in mine else ""))
     return 0
 
 

@@ -31,3 +31,13 @@ def test_touchsim_grows_with_depth_and_pc_follows_250_hz():
     ramp = [touchsim_summary(RECORDING, ("ramp", f"d{d:g}"))["SA1"]["rate"] for d in (0.25, 0.5, 1.0)]
     assert np.all(np.diff(ramp) > 0)
     assert touchsim_summary(RECORDING, ("sine", "f250_a0.05"))["PC"]["rate"] >= 250.0
+
+
+def test_the_side_by_side_runs_ddmm_on_the_whole_named_list():
+    from ddmm.experiments.validation.touchsim_side_by_side import ddmm_responses
+
+    ours = ddmm_responses(seed=0)
+    assert set(ours) == set(named_list()) | {"grating_40mm_s"}
+    assert all(np.isfinite(v["rate"]) for by_type in ours.values() for v in by_type.values())
+    assert ours["ramp_1mm"]["SAI"]["rate"] > ours["ramp_0.25mm"]["SAI"]["rate"]
+    assert ours["grating_40mm_s"]["RAI"]["vs"] > 0.5  # FA-I follow the grating's 40 Hz
