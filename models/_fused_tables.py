@@ -26,6 +26,7 @@ __all__ = [
     "FusedTables",
     "GroupDrive",
     "NoiseKey",
+    "PushState",
     "ShearSample",
     "afferent_table",
     "group_tables",
@@ -131,6 +132,22 @@ class NoiseKey(NamedTuple):
     noisy: bool
     ids: np.ndarray
     sample0: int
+
+
+class PushState(NamedTuple):
+    """A streaming push's filter state: where it is written and where it is read from
+    (`ddmm.models.fused.FusedPipeline.push_drive`).
+
+    Attributes
+    ----------
+    state : ndarray
+        The filter state after the chunk, (n_rows, n_afferents), written.
+    source : ndarray
+        The state before, left as it is; of another shape ((0, 0)): ``state`` holds it and is updated in place.
+    """
+
+    state: np.ndarray
+    source: np.ndarray
 
 
 class GroupDrive(NamedTuple):
@@ -331,6 +348,9 @@ def afferent_table(nap, theta_t, k, spans, consts, unit, fs) -> np.ndarray:
     return aff_f
 
 
+_IDENTITY = np.array([[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]])  # an identity section (`current_filters._PASS_THROUGH`)
+
+
 def group_tables(spans, consts, noise_cv, tuned, fs):
     """(grp_f, grp_i, sos) of the groups ``spans``: each group's stage constants, flags and filter sections."""
     n_groups, n_sec = len(spans), max([sos.shape[0] for _, sos, _, _ in consts] + [1])
@@ -338,7 +358,8 @@ def group_tables(spans, consts, noise_cv, tuned, fs):
     sos_all = np.zeros((n_groups, n_sec, 6))
     for g, ((a, b), (st, sos, alpha_adapt, alpha_smooth)) in enumerate(zip(spans, consts)):
         sos_all[g, :sos.shape[0]] = sos
-        plain = st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
+        plain = (st.derivative == 0 and st.cutoff_hz is None and st.adapt == 0.0 and st.tau_s is None
+                 and np.array_equal(sos, _IDENTITY))  # a front end's sections are not plain
         grp_f[:, g] = [st.adapt, alpha_adapt, st.threshold, alpha_smooth, st.bias, st.negative_weight, st.dynamic,
                        float(-np.expm1(-1.0 / (fs * st.tau_dynamic_s))), st.fall,  # `currents._alpha`
                        st.shear, st.opponent_shear, st.depth, st.transient,

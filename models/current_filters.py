@@ -24,7 +24,7 @@ from ddmm.utils.cache import cache_root
 from ddmm.utils.deprecation import renamed_keyword, warn_renamed
 from ddmm.utils.validation import check_positive
 
-__all__ = ["RAII_FS_FACTOR", "check_fs", "lowpass_sos", "type_filter_constants"]
+__all__ = ["RAII_FS_FACTOR", "check_fs", "lead_lag_sos", "lowpass_sos", "type_filter_constants"]
 
 #: A scene must be sampled at least this many times faster than RA-II's cut-off
 #: (its `ddmm.models.afferent_types.AfferentType.fs_per_cutoff`).
@@ -74,6 +74,41 @@ def lowpass_sos(cutoff_hz: float, order: int, fs: float) -> np.ndarray:
             f"cutoff_hz={cutoff_hz!r} must be below the Nyquist frequency fs/2 = {fs / 2.0} Hz"
         )
     return _butter_sos(float(cutoff_hz), int(order), fs).copy()
+
+
+def lead_lag_sos(zero_hz: float, pole_hz: float, fs: float) -> np.ndarray:
+    """One section of the first-order lead-lag ``(1 + s / w_z) / (1 + s / w_p)`` (w = 2 pi f; unit gain at 0 Hz).
+
+    A zero below the pole is a lead (the drive follows the signal and its
+    rate: gain ``pole_hz / zero_hz`` at high frequencies); a zero above the
+    pole is a lag (high frequencies cut by ``pole_hz / zero_hz``).  Designed
+    by the bilinear map without pre-warping, so it is stable at any rate;
+    corners near or above ``fs / 2`` are compressed towards Nyquist.
+
+    Parameters
+    ----------
+    zero_hz, pole_hz : float
+        Corner frequencies in Hz (> 0).
+    fs : float
+        Sample rate in Hz.
+
+    Returns
+    -------
+    ndarray, shape (1, 6)
+        ``[b0, b1, 0, 1, a1, 0]``, as `lowpass_sos`'s sections.
+
+    Examples
+    --------
+    >>> sos = lead_lag_sos(10.0, 100.0, 1000.0)
+    >>> bool(abs(sos[0, :3].sum() / sos[0, 3:].sum() - 1.0) < 1e-12)  # unit gain at 0 Hz
+    True
+    """
+    zero_hz, pole_hz = check_positive(zero_hz, "zero_hz", "Hz"), check_positive(pole_hz, "pole_hz", "Hz")
+    fs = check_positive(fs, "fs", "Hz")
+    tz, tp, k = 1.0 / (2.0 * np.pi * zero_hz), 1.0 / (2.0 * np.pi * pole_hz), 2.0 * fs
+    # s -> k (1 - z^-1) / (1 + z^-1): (1 + tz s) / (1 + tp s), normalised to a0 = 1
+    a0 = 1.0 + tp * k
+    return np.array([[(1.0 + tz * k) / a0, (1.0 - tz * k) / a0, 0.0, 1.0, (1.0 - tp * k) / a0, 0.0]])
 
 
 @lru_cache(maxsize=64)

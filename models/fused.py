@@ -29,7 +29,10 @@ site mixing) is in `ddmm.models._fused_drive`.
 
 For the streaming encoder's large populations, the front pass also runs on
 afferent ranges in parallel (`_front_parts`): afferents are independent, so
-the bits are the same.
+the bits are the same.  A streaming push (`FusedPipeline.push_drive`) runs
+the front pass per range with the transducers' first pass, keeps each
+range's profile AF from push to push, and leaves the transducers' last pass
+to the engine's own parallel region (`ddmm.models._stage_kernels.TransducerRuns`).
 
 Because the scalar helpers are the very functions the oracle's kernels
 call, and every operation keeps their order, the result is bit-identical to
@@ -104,6 +107,7 @@ from ddmm.models._fused_tables import (
     FusedTables,
     GroupDrive,
     NoiseKey,
+    PushState,
     afferent_table,
     group_tables,
     rest_state,
@@ -113,13 +117,17 @@ from ddmm.models._fused_tables import (
 from ddmm.models._stage_kernels import (
     StageConstants,
     TailState,
+    TransducerPass,
     UnitScales,
     dynamic_step,
     filter_sections,
     receptor_noise_keyed,
     stage_tail,
+    transducer_table,
     transduce_columns,
     transduce_inplace,
+    transduce_mid,
+    transduce_pre,
 )
 from ddmm.models.afferent_types import type_mask
 from ddmm.models.attenuation import F_TH, NO_SHEAR_READINGS, UNTUNED
@@ -134,6 +142,8 @@ __all__ = ["AfferentColumns", "FusedPipeline", "mix_forces", "mixing_matrix"]
 #: Rows (samples) of a drive from which the transducers run fused (`transduce_columns`): below, its
 #: per-call set-up costs more than numpy's few passes save (a streaming push is one row).
 _FUSED_ROWS = 64
+#: A push updating its state in place, and one with no signed transducer (`FusedPipeline.push_drive`).
+_IN_PLACE, _NO_SIGNS = np.zeros((0, 0)), np.zeros((0, 0), np.bool_)
 
 
 @nb.njit(cache=True, nogil=True)
@@ -148,8 +158,10 @@ def _front(tables, state, forces, noise, started, out):
     """
     tables, forces, noise = FusedTables(*tables), ForceInput(*forces), NoiseKey(*noise)
     m = tables.aff_f.shape[1]
+    scratch = front_scratch(m, tables.grp_i.shape[1])
     for a0 in range(0, m, _RANGE):
-        _front_range(tables, state, forces, noise, started, out, a0, min(m, a0 + _RANGE))
+        scratch[7][:] = np.nan  # each range computes its own profiles
+        _front_range(tables, state, forces, noise, started, out, a0, min(m, a0 + _RANGE), scratch)
     return out
 
 
@@ -158,12 +170,51 @@ def _front_parts(tables, state, forces, noise, started, out, bounds):
     """`_front` with the afferent ranges ``bounds[p]..bounds[p+1]`` in parallel (afferents are independent)."""
     tables, forces, noise = FusedTables(*tables), ForceInput(*forces), NoiseKey(*noise)
     for p in nb.prange(bounds.size - 1):
-        _front_range(tables, state, forces, noise, started, out, bounds[p], bounds[p + 1])
+        scratch = front_scratch(tables.aff_f.shape[1], tables.grp_i.shape[1])
+        _front_range(tables, state, forces, noise, started, out, bounds[p], bounds[p + 1], scratch)
     return out
 
 
 @nb.njit(cache=True, nogil=True)
-def _front_range(tables, state, forces, noise, started, out, a0, a1):
+def _front_part(tables, push, forces, noise, started, out, a0, a1, scratch, trans):
+    """A streaming push's front pass on the afferents ``a0..a1``: their columns of ``push.source`` copied into
+    ``push.state`` first (when the source has the state's shape; else the state in place; ``push`` is a
+    `PushState`), `_front_range`, then the transducers' first pass (`transduce_pre`; ``trans`` is the
+    `TransducerPass`)."""
+    state, source = push.state, push.source
+    if source.shape[0] == state.shape[0] and source.shape[1] == state.shape[1]:
+        for r in range(state.shape[0]):
+            state[r, a0:a1] = source[r, a0:a1]
+    _front_range(tables, state, forces, noise, started, out, a0, a1, scratch)
+    transduce_pre(out, trans.runs_i, trans.runs_f, trans.negative, a0, a1)
+
+
+@nb.njit(cache=True, nogil=True)
+def _front_push(tables, push, forces, noise, started, out, scratch, af_dirs, trans):
+    """`_front_part` on every afferent, in one part (``af_dirs[0]``: its profiles' direction; ``push`` and
+    ``trans`` a `PushState` and a `TransducerPass` as plain tuples from Python, named again here)."""
+    tables, forces, noise = FusedTables(*tables), ForceInput(*forces), NoiseKey(*noise)
+    push, trans = PushState(*push), TransducerPass(*trans)
+    f, af, mags, wts, local, words, xi = scratch
+    _front_part(tables, push, forces, noise, started, out, 0, out.shape[1],
+                (f, af, mags, wts, local, words, xi, af_dirs[0]), trans)
+    return out
+
+
+@nb.njit(cache=True, nogil=True, parallel=True)
+def _front_push_parts(tables, push, forces, noise, started, out, scratch, af_dirs, trans, bounds):
+    """`_front_part` on the afferent ranges ``bounds[p]..bounds[p+1]`` in parallel (``af_dirs[p]`` each)."""
+    tables, forces, noise = FusedTables(*tables), ForceInput(*forces), NoiseKey(*noise)
+    push, trans = PushState(*push), TransducerPass(*trans)
+    f, af, mags, wts, local, words, xi = scratch
+    for p in nb.prange(bounds.size - 1):
+        _front_part(tables, push, forces, noise, started, out, bounds[p], bounds[p + 1],
+                    (f, af, mags, wts, local, words, xi, af_dirs[p]), trans)
+    return out
+
+
+@nb.njit(cache=True, nogil=True)
+def _front_range(tables, state, forces, noise, started, out, a0, a1, scratch):
     """Force to linear drive of the afferents ``a0..a1`` into ``out`` (n, n_afferents); their ``state`` in place.
 
     ``forces`` (`ForceInput`) is felt by every afferent, or with
@@ -171,14 +222,16 @@ def _front_range(tables, state, forces, noise, started, out, a0, a1):
     the site forces, mixed here sample by sample.  Groups (runs of one type,
     tuned or not) are the outer loop, so each inner loop over afferents has
     loop-invariant constants and branches.  ``noise`` (`NoiseKey`) keys the
-    receptor noise; ``started`` is False on a scene's first chunk.
+    receptor noise; ``started`` is False on a scene's first chunk.  ``scratch`` is `front_scratch`'s work
+    arrays (columns ``a0..a1`` are used); its profile AF and their direction (``scratch[7]``, NaN: none) are
+    kept from call to call, so a caller that hands the same scratch to the same range reuses them.
     """
     aff_f, grp_f, grp_i, sos, rows = tables.aff_f, tables.grp_f, tables.grp_i, tables.sos, 2 * tables.sos.shape[1]
     reading = DriveConstants(tables.smooth_reading, tables.outside_value, tables.f_th)
     z, offset, (key, noisy, ids, sample0) = state[:rows], state[rows + _OFFSET], noise
     tail = TailState(offset, state[rows + _Y1], state[rows + _Y2], state[rows + _SLOW])
     unit = UnitScales(aff_f[_GAIN], aff_f[_DEAD], aff_f[_CV])
-    f, af, mags, wts, local, words, xi, af_dir = front_scratch(aff_f.shape[1], grp_i.shape[1])
+    f, af, mags, wts, local, words, xi, af_dir = scratch
     shared, sites, weights, mixed, cv_scale = forces.shared, forces.sites, tables.weights, tables.mixed, unit.cv_scale
     for i in range(out.shape[0]):
         sample = sample_shear(shared, sites, weights, local, i, a0, a1, mixed, 2.0 * reading.f_th)
@@ -221,16 +274,26 @@ def _back(tables, state, noise, current, track):
     ``noise`` may come as plain tuples (from Python).
     """
     tables, noise = FusedTables(*tables), NoiseKey(*noise)
+    return _back_range(tables, state, noise, current, track, 0, current.shape[1])
+
+
+@nb.njit(cache=True, nogil=True)
+def _back_range(tables, state, noise, current, track, a0, a1):
+    """`_back` on the afferents ``a0..a1`` alone (each afferent's back pass is its own: the same bits)."""
     aff_f, grp_f, grp_i, sigma_idx = tables.aff_f, tables.grp_f, tables.grp_i, tables.sigma_idx
     rows = 2 * tables.sos.shape[1]
     smooth, dync = state[rows + _SMOOTH], state[rows + _DYNC]
     fastc, risec = state[rows + _FASTC], state[rows + _RISEC]
     lowest = np.inf
-    sub_ids = noise.ids[sigma_idx]
-    words, xi = np.empty(sigma_idx.size, np.uint64), np.empty(sigma_idx.size)
+    k0, k1 = np.searchsorted(sigma_idx, a0), np.searchsorted(sigma_idx, a1)  # sorted: those in a0..a1
+    sub_idx = sigma_idx[k0:k1]
+    sub_ids = noise.ids[sub_idx]
+    words, xi = np.empty(sub_idx.size, np.uint64), np.empty(sub_idx.size)
     for i in range(current.shape[0]):
         for g in range(grp_i.shape[1]):  # groups outside, views from 0: the loops vectorise
-            lo, hi = grp_i[_START, g], grp_i[_STOP, g]
+            lo, hi = max(a0, grp_i[_START, g]), min(a1, grp_i[_STOP, g])
+            if lo >= hi:
+                continue
             x, alpha, bias = current[i, lo:hi], grp_f[_ALPHA_SMOOTH, g], grp_f[_BIAS, g]
             if grp_i[_SMOOTHED, g] != 0:
                 c = smooth[lo:hi]
@@ -248,15 +311,23 @@ def _back(tables, state, noise, current, track):
                 tonic = aff_f[_TONIC, lo:hi]
                 for j in range(hi - lo):
                     x[j] = x[j] + tonic[j]
-        if noise.noisy and sigma_idx.size:
+        if noise.noisy and sub_idx.size:
             normal_row(noise.key, sub_ids, 0, sub_ids.size, noise.sample0 + i, words, xi)
-            for k in range(sigma_idx.size):
-                j = sigma_idx[k]
+            for k in range(sub_idx.size):
+                j = sub_idx[k]
                 current[i, j] = current[i, j] + xi[k] * aff_f[_SIGMA, j]  # `noise_current`
         if track:  # only an explicit method's stability check reads it
-            for j in range(current.shape[1]):
+            for j in range(a0, a1):
                 lowest = min(lowest, current[i, j])
     return lowest
+
+
+def _with_input(consts, sections):
+    """A type's `type_filter_constants` with a front end's ``sections`` run first (None: as they are)."""
+    if sections is None:
+        return consts
+    stage, sos, alpha_adapt, alpha_smooth = consts
+    return stage, np.vstack([np.asarray(sections, dtype=float).reshape(-1, 6), sos]), alpha_adapt, alpha_smooth
 
 
 class FusedPipeline:
@@ -279,6 +350,11 @@ class FusedPipeline:
     neuron_params : dict, optional
         `ddmm.models.neuron.NeuronParams` by type code, overriding
         `NEURON_PARAMS` (both engines integrate with them).
+    input_sections : dict, optional
+        Filter sections (shape (n, 6), as `ddmm.models.current_filters.lowpass_sos`)
+        by type code, run before the type's own filters on the attenuated
+        force: a stimulus front end's transduction (an indentation's,
+        `ddmm.population.stimuli.transduction`); None or a type left out: none.
 
     Attributes
     ----------
@@ -301,7 +377,7 @@ class FusedPipeline:
     """
 
     def __init__(self, columns: AfferentColumns, params, fs: float, *, no_shear: str = "pass", f_th: float = F_TH,
-                 mixing=None, neuron_params=None):
+                 mixing=None, neuron_params=None, input_sections=None):
         if not isinstance(columns, AfferentColumns):
             raise TypeError(f"columns must be an AfferentColumns, got {type(columns).__name__}")
         check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
@@ -316,7 +392,8 @@ class FusedPipeline:
                                                 dtype=np.int64)
         self.n_afferents, self.fs = afferent_type.size, float(fs)
         spans = type_runs(afferent_type, nap)  # runs of one type, tuned or not
-        consts = [type_filter_constants(params, str(afferent_type[a]), self.fs) for a, _ in spans]
+        consts = [_with_input(type_filter_constants(params, str(afferent_type[a]), self.fs),
+                              (input_sections or {}).get(str(afferent_type[a]))) for a, _ in spans]
         self.phase = np.zeros(self.n_afferents)  # per afferent: its type's start-phase spread (`TypeParams.phase`)
         for (a, b), (stage, *_) in zip(spans, consts):
             self.phase[a:b] = stage.phase
@@ -336,6 +413,7 @@ class FusedPipeline:
             self.excite_cv[a:b] = params.excite_cv(str(afferent_type[a]))
         self.excite_any, self._excite = bool(np.any(self.excite_cv > 0)), (None, None)
         self.transducers, self._plain = transducer_runs(spans, consts)  # numpy's calls cost per call
+        self.transducer_runs = transducer_table(self.transducers, self._plain)  # a streaming push's split passes
 
     def advance(self, forces, state, sample0, key, neuron_state, *, dt, method, engine, parts=1):
         """One chunk through the whole pipeline: (afferent, step within the chunk, `NeuronState` after).
@@ -424,6 +502,56 @@ class FusedPipeline:
             for cols in self._plain:  # runs without a transducer: the factor alone
                 drive[:, cols] *= excite[cols]
         return drive
+
+    def push_work(self, bounds):
+        """The work arrays of streaming pushes on the afferent ranges ``bounds`` (`push_drive`), made once:
+        `front_scratch`'s arrays but the last, each range's profile direction (n_ranges, 2, n_groups; NaN:
+        none yet) and the excitability factor of a trial without one (ones)."""
+        def make():
+            m = self.n_afferents
+            scratch = (np.empty(m), np.empty(m), np.empty(m), np.empty(m), np.empty((3, m)), np.empty(m, np.uint64),
+                       np.empty(m))
+            return scratch, np.full((bounds.size - 1, 2, self.tables.grp_i.shape[1]), np.nan), np.ones(m)
+        return self.memo(("push work", bounds.tobytes()), make)
+
+    def push_drive(self, forces, state, source, started, sample0, key, bounds, noise=None):
+        """A streaming push's drive on the afferent ranges ``bounds`` (in parallel when more than one), all
+        but the transducers' last pass: (drive, sign mask), shape (n_samples, n_afferents) each.
+
+        The engine finishes each range with `transduce_post` (``* i_max`` and
+        the sign mask; its `TransducerRuns` is `transducer_runs`) and
+        `_back_range`, in its own parallel region
+        (`ddmm.models.engines.direct_fused`): the drive then equals
+        `drive`'s, bit for bit.  ``state`` receives the filter state after
+        the chunk; the state before is read from ``source`` (left as it is),
+        or, when ``source`` is ``state``, ``state`` is updated in place.
+        Each range keeps its profile AF from push to push (`push_work`): a
+        shear direction held from the last push costs no profile evaluation.
+        ``noise`` is ``tuple(noise_key(key, sample0))`` if the caller has it.  Other arguments as `drive`.
+        """
+        mixed = self.mixing is not None
+        if forces.ndim != (3 if mixed else 2):
+            raise ValueError(f"forces must be {'(n, n_sites, 3) site forces' if mixed else '(n, 3)'} for this pipeline, "
+                             f"got shape {forces.shape}")
+        scratch, af_dirs, ones = self.push_work(bounds)
+        runs = self.transducer_runs
+        out = np.empty((forces.shape[0], self.n_afferents))
+        negative = np.empty(out.shape, np.bool_) if runs.signed else _NO_SIGNS
+        args = (self.kernel_tables, (state, _IN_PLACE if source is state else source),  # `PushState`
+                (_NO_FORCES, forces) if mixed else (forces, _NO_SITES),
+                tuple(self.noise_key(key, sample0)) if noise is None else noise, started,
+                out, scratch, af_dirs, (runs.runs_i, runs.runs_f, negative))  # `TransducerPass`
+        if bounds.size <= 2:
+            _front_push(*args)
+        else:  # the parallel kernel is called from Python (see `drive`)
+            _front_push_parts(*args, bounds)
+        for cols in runs.sat:  # numpy's log1p and tanh, as `transduce_inplace` (one call per run of columns)
+            np.log1p(out[:, cols], out=out[:, cols])
+        transduce_mid(out, runs.runs_i, runs.runs_f, self.excitability(key) if key is not None and self.excite_any
+                      else ones)
+        for cols in runs.bounded:
+            np.tanh(out[:, cols], out=out[:, cols])
+        return out, negative
 
     def excitability(self, key) -> np.ndarray:
         """The trial's excitability factor per afferent (`ddmm.models.currents.excitability`), cached per key."""

@@ -15,7 +15,7 @@ Around it, one subpackage per concern:
   encoder, the step chosen for a tolerance, Dask;
 - `analysis`: direction tuning, decoders, torque and slip, the physiology
   scorecard;
-- `io`: sensor-array readers, NWB and Neo export.
+- `io`: sensor-array readers, recorded LSL sessions (XDF), NWB and Neo export.
 
 Names are imported on first use (PEP 562), so ``import ddmm.population``
 costs only what a caller touches: no xarray before a dataset is built, no
@@ -27,6 +27,7 @@ from ddmm.utils.lazy import lazy_exports
 _WHERE = {
     "io.arrays": ("from_array", "from_long_csv"),
     "io.array_writers": ("save_array",),
+    "io.xdf": ("from_xdf", "read_xdf"),
     "dataset": ("binned_counts", "binned_rates", "describe_dataset", "load_dataset", "psth", "save_dataset"),
     "io.neo_export": ("to_neo",),
     "io.brian2_export": ("to_brian2",),

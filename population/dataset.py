@@ -11,7 +11,8 @@ Schema (names are fixed):
   ``duration`` (s), ``theta_r`` (deg) with ``has_theta_r`` (1 when the scene
   has one nominal shear direction), and when a scene has a contact
   ``contact_x_mm``, ``contact_y_mm``, ``contact_radius_mm`` (NaN for a scene
-  without); ``time`` (s); ``stage`` (labels of the
+  without), and for indentation scenes ``skin`` and ``transduction_<type>_gain``,
+  ``_zero_hz``, ``_pole_hz`` (NaN for a scene without, or a type without a filter); ``time`` (s); ``stage`` (labels of the
   scenes' phases, with ``stage_start``/``stage_end(condition, stage)`` in s);
 * data vars ``spike_count(condition, trial, afferent)``; the events
   ``spike_time`` (s), ``spike_afferent`` (position on ``afferent``),
@@ -135,7 +136,25 @@ def _condition_coords(scenes) -> dict:
         "has_theta_r": xr.Variable("condition", np.array([s.theta_r is not None for s in scenes], np.int8),
                                    {"units": "1"}),
         **_contact_coords(scenes),
+        **_spread_coords(scenes),
     }
+
+
+def _spread_coords(scenes) -> dict:
+    """Per condition, what a scene's own spread records of itself (`describe()`: an indentation's skin and
+    transduction); a condition without it gets NaN (numbers) or "" (text)."""
+    described = [getattr(getattr(getattr(s, "sites", None), "spread", None), "describe", lambda: {})() for s in scenes]
+    names = sorted({name for d in described for name in d})
+    coords = {}
+    for name in names:
+        values = [d.get(name) for d in described]
+        if all(isinstance(v, str) or v is None for v in values):
+            coords[name] = xr.Variable("condition", np.array(["" if v is None else v for v in values], dtype=object))
+        else:
+            unit = "Hz" if name.endswith("_hz") else "1"
+            coords[name] = xr.Variable("condition", np.array([np.nan if v is None else float(v) for v in values]),
+                                       {"units": unit})
+    return coords
 
 
 def _contact_coords(scenes) -> dict:

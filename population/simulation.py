@@ -22,7 +22,7 @@ from ddmm.models.attenuation import NO_SHEAR_READINGS
 from ddmm.models.current_filters import check_fs
 from ddmm.models.engines import METHODS, get_engine, prepare, substeps_for
 from ddmm.models.fused import AfferentColumns, FusedPipeline, mixing_matrix
-from ddmm.population.anatomy.receptive_fields import frame_theta, local_mixing
+from ddmm.population.anatomy.receptive_fields import frame_theta, input_sections, local_mixing
 from ddmm.population.runtime.memory import check_run_memory
 from ddmm.population.runtime.noise import noise_key, root_seed
 from ddmm.population.runtime.plan import RECORD_CHOICES, make_plan
@@ -112,15 +112,17 @@ def block_pipeline(population, fs: float, sites, scale, no_shear: str):
     uses ``theta_T + frame_deg`` (`spatial.frame_theta`).
     """
     pop = population
-    theta, mixing = pop.theta_t, None
+    theta, mixing, sections = pop.theta_t, None, None
     if sites is not None:
         theta = frame_theta(pop)
         indptr, indices, coeff, _ = local_mixing(pop.x_mm, pop.y_mm, pop.afferent_type, sites, pop.receptive_field)
         mixing = mixing_matrix(indptr, indices, coeff, len(sites))
+        sections = input_sections(sites, fs)
     columns = AfferentColumns(afferent_type=pop.afferent_type, nap=pop.nap, theta_t=theta, k=pop.k, scale=scale,
                               noise_cv=pop.noise_cv, noise_sigma=pop.noise_sigma, afferent_id=pop.afferent_id,
                               sensitivity=pop.sensitivity)
-    return FusedPipeline(columns, pop.current, fs, no_shear=no_shear, mixing=mixing, neuron_params=pop.neuron)
+    return FusedPipeline(columns, pop.current, fs, no_shear=no_shear, mixing=mixing, neuron_params=pop.neuron,
+                         input_sections=sections)
 
 
 def chunk_forces(scene, sl: slice) -> np.ndarray:

@@ -20,8 +20,8 @@ import json
 import resource
 import time
 
-__all__ = ["CASES", "EVENT_CASES", "EXTRA_CASES", "GROUPS", "LSL_CASES", "SCALING", "SITE_BASELINES", "run_case",
-           "run_extra"]
+__all__ = ["CASES", "EVENT_CASES", "EXTRA_CASES", "GROUPS", "LSL_CASES", "SCALING", "SITE_BASELINES", "kernel_ms_per_ms",
+           "run_case", "run_extra"]
 
 #: name -> (population, engine, simulated seconds, warm-up?)
 CASES = {
@@ -35,7 +35,7 @@ CASES = {
 #: workers, and the streaming encoder's per-chunk latency (raw forces, and through the conditioning stage).
 EXTRA_CASES = ("scale_100k_inprocess", "scale_100k_2workers", "stream_fingertip", "stream_hand",
                "stream_fingertip_conditioned", "hand_5sites_1s_direct", "fingertip_16taxels_1s_direct",
-               "hand_vibration_1s_direct", "stimulate_hand_16")
+               "hand_vibration_1s_direct", "fingertip_scan_1s_direct", "stimulate_hand_16")
 #: ``--cases lsl``: sample-to-spike latency over Lab Streaming Layer beside the in-process push (extra ddmm[lsl]).
 LSL_CASES = ("lsl_fingertip", "lsl_hand")
 #: ``--cases scaling``: afferents x simulated seconds, each in a fresh process.
@@ -46,7 +46,7 @@ EVENT_CASES = ("events_100hz", "events_1khz", "events_5khz", "events_lsl")
 GROUPS = {"scaling": SCALING, "lsl": LSL_CASES, "events": EVENT_CASES}
 #: Multi-site cases and the one-site case each is compared with (same population, same run).
 SITE_BASELINES = {"hand_5sites_1s_direct": "hand_1s_direct", "fingertip_16taxels_1s_direct": "fingertip_1s_direct",
-                  "hand_vibration_1s_direct": "hand_1s_direct"}
+                  "hand_vibration_1s_direct": "hand_1s_direct", "fingertip_scan_1s_direct": "fingertip_1s_direct"}
 DT = 1e-4
 
 
@@ -205,6 +205,7 @@ def _stream_case(population: str, seconds: float = 3.0, conditioned: bool = Fals
         unpaced[k] = time.perf_counter() - start
     enc.reset()
     enc.wait_ready()  # a stimulator bridge primes the encoder before the stream starts
+    kernel = kernel_ms_per_ms(len(pop))  # the yardstick, timed before and after the paced pushes
     laps = np.empty(forces.shape[0])
     t0 = time.perf_counter()
     for k in range(forces.shape[0]):
@@ -216,14 +217,25 @@ def _stream_case(population: str, seconds: float = 3.0, conditioned: bool = Fals
         start = time.perf_counter()
         enc.push(forces[k:k + 1])
         laps[k] = time.perf_counter() - start
+    kernel = kernel + kernel_ms_per_ms(len(pop))
+    p99_ms, kernel_ms = float(np.percentile(laps, 99)) * 1e3, float(np.median(kernel))
     return {"name": f"stream_{population}" + ("_conditioned" if conditioned else ""), "engine": "direct", "n_afferents": len(pop), "sim_s": seconds,
             "dt_ms": DT * 1e3, "wall_s": round(float(laps.sum()), 3),
             "afferent_s_per_wall_s": round(len(pop) * seconds / float(laps.sum()), 1),
             "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
             "chunk_ms": 1.0, "median_ms": round(float(np.median(laps)) * 1e3, 4),
-            "p99_ms": round(float(np.percentile(laps, 99)) * 1e3, 4), "max_ms": round(float(laps.max()) * 1e3, 3),
+            "p99_ms": round(p99_ms, 4), "max_ms": round(float(laps.max()) * 1e3, 3),
             "unpaced_median_ms": round(float(np.median(unpaced)) * 1e3, 4),
-            "unpaced_p99_ms": round(float(np.percentile(unpaced, 99)) * 1e3, 4)}
+            "unpaced_p99_ms": round(float(np.percentile(unpaced, 99)) * 1e3, 4),
+            "kernel_ms_per_sim_ms": round(kernel_ms, 4), "p99_over_kernel": round(p99_ms / kernel_ms, 2)}
+
+
+def kernel_ms_per_ms(n: int, runs: int = 3) -> list:
+    """The integration kernel alone (`_kernel_alone`: n neurons x 1 s, every thread) per simulated millisecond,
+    in ms, for each of ``runs`` timed calls after a warm-up: the yardstick of a 1 ms push of n afferents."""
+    kernel = _kernel_alone(n, 1.0)
+    kernel()
+    return [_median_wall(kernel, 1)[0] for _ in range(runs)]  # s per simulated s = ms per simulated ms
 
 
 def _site_scene(population: str, sim_s: float):
@@ -257,21 +269,35 @@ def _vibration_scene():
     return indent(probe(pad[0], pad[1], radius_mm=0.5), depth, fs=5000.0, name="vibration_250hz")
 
 
+def _scan_scene():
+    """The named list's grating for 1 s: 1 mm period scanned at 40 mm/s across a 6 x 6 mm window of 0.2 mm pins
+    (900 pins) at the fingertip's centre, contact 0.8 mm, with friction, at 5 kHz."""
+    from ddmm.population.stimuli.surfaces import grating, scan
+
+    return scan(grating(1.0, 0.5, 0.5), speed_mm_s=40.0, duration_s=1.0, contact_mm=0.8, window_mm=(6.0, 6.0),
+                pitch_mm=0.2, fs=5000.0, name="grating_scan_1s")
+
+
+_SCENES = {"vibration": _vibration_scene, "scan": _scan_scene}  # indentation cases: their scene's maker
+
+
 def _sites_case(name: str) -> dict:
     """A multi-site case: the whole pipeline on `_site_scene` (or an indentation, its mechanics included in
     the time), after one warm-up."""
     from ddmm.population import sample_population, simulate
 
     population = name.split("_")[0]
-    make = _vibration_scene if "vibration" in name else (lambda: _site_scene(population, 1.0))
+    make = next((m for key, m in _SCENES.items() if key in name), lambda: _site_scene(population, 1.0))
     pop = sample_population(population, rng=0)
     simulate(pop, make(), engine="direct", dt=DT, seed=0, quiet=True)
     start = time.perf_counter()
     scene = make()
+    built = time.perf_counter()
     ds = simulate(pop, scene, engine="direct", dt=DT, seed=0, quiet=True)
     wall = time.perf_counter() - start
     return {"name": name, "engine": "direct", "n_afferents": len(pop), "sim_s": 1.0, "dt_ms": DT * 1e3,
-            "wall_s": round(wall, 4), "afferent_s_per_wall_s": round(len(pop) / wall, 1),
+            "wall_s": round(wall, 4), "scene_s": round(built - start, 4),
+            "afferent_s_per_wall_s": round(len(pop) / wall, 1),
             "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
             "spikes": int(ds.sizes["spike"]), "n_sites": scene.n_sites}
 

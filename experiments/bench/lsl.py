@@ -8,6 +8,11 @@ One case process does, on the same samples (a Birznieks ramp-hold at 1 kHz, 3 s)
    publishes the samples on a force outlet in real time (one every millisecond, stamped with its
    push time) and reads the spike stream.  A spike's latency is its arrival here minus the push
    time of the force sample it fell in (the sample whose period holds the spike's model time).
+   The spike stream's format (``--lsl-spike-format``) is the case's (`FORMATS`): the hand's is
+   ``batched`` (one frame per push: in ``events``, one LSL sample per spike, its contact-onset
+   bursts of ~2,000 spikes a millisecond cost liblsl most of the period); the fingertip runs both,
+   ``events`` first (its ``lsl_latency``).  Frames are decoded after the run (`decode_spikes`), so
+   the reader thread only copies what arrives.
 
 Both are reported per force sample that produced spikes (over LSL: until its last spike
 arrives; in process: its push, which returns all its spikes) and, in process, over all samples.
@@ -27,7 +32,10 @@ import uuid
 
 import numpy as np
 
-__all__ = ["run_lsl_case", "publish"]
+__all__ = ["FORMATS", "publish", "run_lsl_case"]
+
+#: The spike stream formats each case runs over LSL, its ``lsl_latency`` first.
+FORMATS = {"lsl_fingertip": ("events", "batched"), "lsl_hand": ("batched",)}
 
 _FS = 1000.0
 _LOOPBACK = ("[ports]\nIPv6 = disable\n[multicast]\nResolveScope = machine\n[lab]\nKnownPeers = {127.0.0.1}\n"
@@ -53,6 +61,7 @@ def _paced(n: int, act) -> np.ndarray:
 
 
 def _in_process(pop, forces):
+    from ddmm.experiments.bench.cases import kernel_ms_per_ms
     from ddmm.population.runtime.stream import Encoder
 
     enc = Encoder(pop, _FS, seed=0)
@@ -65,24 +74,33 @@ def _in_process(pop, forces):
         lap = time.perf_counter() - start
         spiking[k] = out.afferent.size > 0
         return lap
+    kernel = kernel_ms_per_ms(len(pop))  # the yardstick, timed before and after the paced pushes
     laps = _paced(forces.shape[0], push)
-    return laps, spiking
+    return laps, spiking, float(np.median(kernel + kernel_ms_per_ms(len(pop))))
 
 
 def _reader(inlet, arrivals, stop):
-    """Note each chunk of spikes with its arrival: a reader that allocates nothing per pull, as the bridge's."""
+    """Note each chunk of samples with its arrival: a reader that allocates nothing per pull, as the bridge's,
+    and copies the samples as they are (decoded after the run, `_decoded`)."""
     import pylsl
 
     from ddmm.population.runtime.lsl import ChunkReader
 
-    reader = ChunkReader(inlet, 4096)
+    reader = ChunkReader(inlet, max(64, 4096 // int(inlet.channel_count)))  # events 4,096 spikes; 64 frames
     while not stop.is_set():
-        _, stamps = reader.pull(0.05)
+        samples, stamps = reader.pull(0.05)
         if len(stamps):
-            arrivals.append((pylsl.local_clock(), stamps.copy()))  # the reader's buffer is reused
+            arrivals.append((pylsl.local_clock(), samples.copy(), stamps.copy()))  # the buffers are reused
 
 
-def _over_lsl(population: str, forces):
+def _decoded(arrivals, spike_format: str):
+    """[(arrival, spike stamps)] from the reader's [(arrival, samples, sample stamps)]."""
+    from ddmm.population.runtime.spike_formats import decode_spikes
+
+    return [(arrived, decode_spikes(samples, stamps, spike_format)[1]) for arrived, samples, stamps in arrivals]
+
+
+def _over_lsl(population: str, forces, spike_format: str):
     import pylsl
 
     from ddmm.population.runtime.lsl import open_force_outlet
@@ -91,21 +109,24 @@ def _over_lsl(population: str, forces):
     names = f"bench-force-{uuid.uuid4().hex[:8]}", f"bench-spikes-{uuid.uuid4().hex[:8]}"
     outlet = open_force_outlet(names[0], fs=_FS)
     proc = subprocess.Popen([sys.executable, "-m", "ddmm.experiments.cli", "stream", "--lsl-in", names[0],
-                             "--lsl-out", names[1], "--population", population, "--seed", "0",
-                             "--resolve-timeout", "120"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            text=True)
+                             "--lsl-out", names[1], "--lsl-spike-format", spike_format, "--population", population,
+                             "--seed", "0", "--resolve-timeout", "120"], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True)
     try:
         found = pylsl.resolve_byprop("name", names[1], 1, 180.0)
         if not found:
             raise RuntimeError(f"the bridge's spike stream did not appear: {proc.stderr.read() if proc.poll() else ''}")
-        inlet = pylsl.StreamInlet(found[0], max_buflen=100_000)
-        offset = float(read_spike_metadata(inlet.info(timeout=10.0))["input"]["clock_offset_s"])
+        # max_buflen: x100 samples, an irregular stream's (10 M spikes in events, 10 M frames in batched)
+        inlet = pylsl.StreamInlet(found[0], max_buflen=100_000 if spike_format == "events" else 1_000)
+        meta = read_spike_metadata(inlet.info(timeout=10.0))
+        if meta["format"] != spike_format:
+            raise RuntimeError(f"the bridge published {meta['format']!r} spikes, not {spike_format!r}")
         inlet.open_stream(timeout=10.0)
         pushed, t0, arrivals = publish(pylsl, outlet, inlet, forces, _reader)
     finally:
         proc.terminate()
         proc.communicate(timeout=60)
-    return pushed, t0 + offset, arrivals
+    return pushed, t0 + float(meta["input"]["clock_offset_s"]), _decoded(arrivals, spike_format)
 
 
 def publish(pylsl, outlet, inlet, forces, reader):
@@ -155,12 +176,19 @@ def run_lsl_case(name: str, seconds: float = 3.0) -> dict:
         pop = sample_population(population, rng=0)
         scene = birznieks(90.0, hold_s=seconds - 0.25)
         forces = np.column_stack([scene.fx, scene.fy, scene.fz])
-        laps, spiking = _in_process(pop, forces)
-        pushed, anchor, arrivals = _over_lsl(population, forces)
-    latency = _latencies(pushed, anchor, arrivals)
-    spikes = int(sum(a[1].size for a in arrivals))
+        laps, spiking, kernel_ms = _in_process(pop, forces)
+        by_format = {}
+        for spike_format in FORMATS[name]:
+            pushed, anchor, arrivals = _over_lsl(population, forces, spike_format)
+            latency = _latencies(pushed, anchor, arrivals)
+            by_format[spike_format] = {"spikes": int(sum(a[1].size for a in arrivals)),
+                                       "latency": _stats(latency) if latency.size else {}}
+    first = by_format[FORMATS[name][0]]
     return {"name": name, "engine": "direct", "n_afferents": len(pop), "sim_s": seconds, "dt_ms": 0.1,
             "wall_s": round(float(laps.sum()), 3), "afferent_s_per_wall_s": round(len(pop) * seconds / laps.sum(), 1),
             "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1),
-            "spikes_over_lsl": spikes, "lsl_latency": _stats(latency) if latency.size else {},
-            "in_process_spiking": _stats(laps[spiking]), "in_process_all": _stats(laps)}
+            "spike_format": FORMATS[name][0], "spikes_over_lsl": first["spikes"], "lsl_latency": first["latency"],
+            "lsl_by_format": by_format,
+            "in_process_spiking": _stats(laps[spiking]), "in_process_all": _stats(laps),
+            "kernel_ms_per_sim_ms": round(kernel_ms, 4),
+            "in_process_p99_over_kernel": round(float(np.percentile(laps, 99)) * 1e3 / kernel_ms, 2)}

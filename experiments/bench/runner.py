@@ -107,16 +107,26 @@ def _row(c: dict) -> str:
     if "median_ms" in c:
         notes.append(f"per 1 ms chunk, real-time paced: median {c['median_ms']:.3f} ms, p99 {c['p99_ms']:.3f} ms; "
                      f"back to back: {c['unpaced_median_ms']:.3f} / {c['unpaced_p99_ms']:.3f} ms")
+        if "kernel_ms_per_sim_ms" in c:
+            notes.append(f"integration kernel alone {c['kernel_ms_per_sim_ms']:.3f} ms per simulated ms; paced p99 / "
+                         f"kernel {c['p99_over_kernel']:.2f}")
     if "electrodes" in c:
         notes.append(f"per 1 ms chunk with {c['electrodes']} electrodes: median {c['stimulation_median_ms']:.3f} "
                      f"ms, p99 {c['stimulation_p99_ms']:.3f} ms; the encoder alone {c['encoder_median_ms']:.3f} / "
                      f"{c['encoder_p99_ms']:.3f} ms")
     if "lsl_latency" in c:
-        lsl, own = c["lsl_latency"], c["in_process_spiking"]
-        notes.append(f"sample-to-spike over LSL: median {lsl.get('median_ms', float('nan')):.3f} ms, p99 "
-                     f"{lsl.get('p99_ms', float('nan')):.3f} ms, worst {lsl.get('max_ms', float('nan')):.2f} ms; "
+        lsl, own, fmt = c["lsl_latency"], c["in_process_spiking"], c.get("spike_format", "events")
+        notes.append(f"sample-to-spike over LSL ({fmt} spikes): median {lsl.get('median_ms', float('nan')):.3f} ms, "
+                     f"p99 {lsl.get('p99_ms', float('nan')):.3f} ms, worst {lsl.get('max_ms', float('nan')):.2f} ms; "
                      f"in-process push of the same samples: {own['median_ms']:.3f} / {own['p99_ms']:.3f} / "
                      f"{own['max_ms']:.2f} ms ({c['spikes_over_lsl']:,} spikes)")
+        for other, got in c.get("lsl_by_format", {}).items():
+            if other != fmt and got["latency"]:
+                notes.append(f"{other} spikes over LSL: median {got['latency']['median_ms']:.3f} ms, p99 "
+                             f"{got['latency']['p99_ms']:.3f} ms ({got['spikes']:,} spikes)")
+        if "kernel_ms_per_sim_ms" in c:
+            notes.append(f"integration kernel alone {c['kernel_ms_per_sim_ms']:.3f} ms per simulated ms; in-process "
+                         f"p99 / kernel {c['in_process_p99_over_kernel']:.2f}")
     if "over_kernel" in c:
         low, high = c["over_kernel_range"]
         notes.append(f"integration kernel alone {c['kernel_s']:.3f} s; pipeline / kernel {c['over_kernel']:.2f} "

@@ -11,9 +11,10 @@ import re
 from pathlib import Path
 
 from ddmm.experiments.cli.recording_options import (
+    RECORDINGS,
     add_recording_options,
     conditioning_from_args,
-    csv_scene,
+    recorded_scene,
     refuse_csv_options,
 )
 from ddmm.experiments.io import seed_arg
@@ -39,11 +40,12 @@ def add_run_options(p, *, out_required: bool) -> None:
     """The options of ``ddmm simulate`` and ``ddmm plan``: population, scene, engine, step, trials, output."""
     p.add_argument("--population", default="fingertip", help="fingertip, hand or a spec .toml file")
     p.add_argument("--scene", default="birznieks",
-                   help=f"{', '.join(SCENES)}, a force .csv file, or a sensor-array file "
-                        f"({', '.join(EXTENSIONS)}; a long .csv with --sites)")
+                   help=f"{', '.join(SCENES)}, a force .csv file, an .xdf session (LabRecorder; with --stream), "
+                        f"or a sensor-array file ({', '.join(EXTENSIONS)}; a long .csv with --sites)")
     p.add_argument("--sites", default=None, metavar="SITES.csv",
                    help="sites table (site,x_mm,y_mm[,region][,radius_mm]): --scene is then a long CSV "
-                        "of time,site,fx,fy,fz")
+                        "of time,site,fx,fy,fz; with an .xdf --scene, the sites of its stream's channels "
+                        "(or 'fingertips', as ddmm stream)")
     p.add_argument("--theta-r", default=None, metavar="DEG[,DEG...]",
                    help="shear direction(s) in degrees, one condition each ('none': normal only); default 90")
     p.add_argument("--contact", default=None, metavar="X,Y,R", help="contact centre and radius in mm")
@@ -66,7 +68,7 @@ def add_run_options(p, *, out_required: bool) -> None:
     p.add_argument("--scheduler", default=None, metavar="processes|ADDRESS",
                    help="run afferent blocks on Dask: a local pool of processes or a scheduler address")
     p.add_argument("--out", required=out_required, metavar="FILE.nc")
-    add_recording_options(p)
+    add_recording_options(p, xdf=True)
 
 
 def step_ms(text) -> float:
@@ -117,8 +119,10 @@ def _array_scene(args):
     """The sensor-array scene of ``--scene FILE`` (and ``--sites``), or None for any other ``--scene``."""
     suffix = Path(args.scene).suffix.lower()
     is_array = suffix in EXTENSIONS or (suffix == ".csv" and args.sites is not None)
-    if args.sites is not None and suffix != ".csv":
-        raise ValueError(f"--sites goes with a long .csv --scene (time,site,fx,fy,fz), not {args.scene!r}")
+    with_sites = suffix in RECORDINGS and RECORDINGS[suffix].sites  # --sites names a recording's channel sites
+    if args.sites is not None and suffix != ".csv" and not with_sites:
+        raise ValueError(f"--sites goes with a long .csv --scene (time,site,fx,fy,fz) or an .xdf one, not "
+                         f"{args.scene!r}")
     if not is_array:
         return None
     if args.contact is not None:
@@ -161,6 +165,9 @@ def _indent_scene(args):
 def scenes_from_args(args) -> list:
     """The scenes named by ``--scene``, ``--sites``, ``--theta-r`` and ``--contact``."""
     from ddmm.population import birznieks, press_push_lift, rotating_shear
+    found = RECORDINGS.get(Path(args.scene).suffix.lower())
+    if getattr(args, "stream", None) is not None and (args.indent is not None or not (found and found.streams)):
+        raise ValueError(f"--stream picks a stream of an .xdf --scene, not of {args.scene!r}")
     if args.indent is not None:
         return [_indent_scene(args)]
     array = _array_scene(args)
@@ -177,13 +184,12 @@ def scenes_from_args(args) -> list:
     if args.scene == "rotating-shear":
         start = parse_directions(args.theta_r, default="0")
         return [rotating_shear(start_deg=start[0] or 0.0, contact=contact)]
-    if args.scene.lower().endswith(".csv"):
-        if args.theta_r is not None:
-            raise ValueError(f"--theta-r does not apply to the recorded scene {args.scene!r}: the file gives the "
-                             "forces")
-        return [csv_scene(args.scene, args, contact)]
-    raise ValueError(f"--scene {args.scene!r} is unknown; allowed: {', '.join(SCENES)}, a .csv file or a "
-                     f"sensor-array file ({', '.join(EXTENSIONS)}){_closest(args.scene.replace('_', '-'), SCENES)}")
+    recorded = recorded_scene(args, contact)
+    if recorded is not None:
+        return [recorded]
+    raise ValueError(f"--scene {args.scene!r} is unknown; allowed: {', '.join(SCENES)}, a recording "
+                     f"({', '.join(RECORDINGS)}) or a sensor-array file ({', '.join(EXTENSIONS)})"
+                     f"{_closest(args.scene.replace('_', '-'), SCENES)}")
 
 
 def _closest(word: str, names) -> str:

@@ -6,7 +6,9 @@ line is skipped), or an LSL force stream (``--lsl-in NAME``: 3 channels per
 site, its rate and units from the stream, docs/live-sensors.md).  Output:
 CSV lines ``t,afferent,type`` on standard output (the afferent's id, its
 type), flushed after every input chunk, or an LSL spike stream
-(``--lsl-out NAME``: one int32 sample per spike holding the afferent id).
+(``--lsl-out NAME``: one int32 sample per spike holding the afferent id;
+with ``--lsl-spike-format batched``, one frame of int32 per push carrying
+the same ids and stamps, `ddmm.population.runtime.spike_formats`).
 
 **Time base.**  On standard output ``t`` is on the input's clock, in both
 modes: the first sample's time (the first CSV column, or the LSL stamp the
@@ -23,7 +25,11 @@ reported on stderr and skipped; a gap in the stamps (an interval over
 1.5 / fs) is reported with its time and length, the samples are taken as
 consecutive and the spike times move on by the gap.  It stops at the end of
 input, on SIGINT/SIGTERM, or after ``--duration`` seconds of input, and
-prints a one-line summary on stderr.
+prints a one-line summary on stderr.  An LSL sender that fails -- no sample
+for ``--lsl-timeout`` seconds (default 2) once samples have come, or its
+stream lost mid-stream (a sender killed) -- is reported on stderr with the time since its last sample;
+what was produced is written, and the exit status is `SENDER_FAILED_STATUS`
+(3), apart from 0 (done) and 2 (an error).
 
 ``ddmm play`` (`ddmm.experiments.cli.play`) publishes a scene's forces as an
 LSL force stream in real time: a synthetic sensor for trying ``--lsl-in``.
@@ -38,15 +44,22 @@ from contextlib import contextmanager
 import numpy as np
 
 from ddmm.experiments.cli.options import add_engine_option, step_ms
-from ddmm.experiments.cli.recording_options import add_recording_options, conditioning_from_args
+from ddmm.experiments.cli.recording_options import add_recording_options, conditioning_from_args, sites_option
 from ddmm.experiments.io import quiet_liblsl, seed_arg
+from ddmm.population.runtime.spike_formats import SPIKE_FORMATS
 
-__all__ = ["bounded_lines", "register", "stop_on_signals", "stream"]
+__all__ = ["SENDER_FAILED_STATUS", "bounded_lines", "register", "stop_on_signals", "stream"]
+
+#: The exit status of ``ddmm stream --lsl-in`` when its sender failed (silent past --lsl-timeout, or lost).
+SENDER_FAILED_STATUS = 3
 
 
 def register(sub) -> None:
     """Add ``ddmm stream``."""
-    p = sub.add_parser("stream", help="encode live force samples (stdin or LSL) into spike events (stdout or LSL)")
+    p = sub.add_parser("stream", help="encode live force samples (stdin or LSL) into spike events (stdout or LSL)",
+                       epilog=f"exit status: 0 at the end of input, on a signal or after --duration; 2 on an error; "
+                              f"{SENDER_FAILED_STATUS} when the LSL sender failed (no sample for --lsl-timeout "
+                              "seconds, or its stream lost mid-stream), after what was produced is written")
     p.add_argument("--population", default="fingertip")
     p.add_argument("--fs", type=float, default=None,
                    help="sample rate of the input in Hz (required on stdin; an LSL stream states its own)")
@@ -66,8 +79,15 @@ def register(sub) -> None:
     g.add_argument("--lsl-in", default=None, metavar="NAME", help="read forces from the LSL stream of this name")
     g.add_argument("--lsl-source-id", default=None, metavar="ID", help="pick one of several streams of that name")
     g.add_argument("--lsl-out", default=None, metavar="NAME", help="publish spikes as an LSL stream of this name")
+    g.add_argument("--lsl-spike-format", default=None, choices=tuple(SPIKE_FORMATS),
+                   help="the spike stream's samples: 'events', one per spike (default), or 'batched', one frame "
+                        "of up to 2,048 int32 per push, decoded by decode_spikes (the whole hand at 1 kHz; "
+                        "docs/live-sensors.md)")
     g.add_argument("--resolve-timeout", type=float, default=5.0, metavar="S",
                    help="seconds to wait for the input stream (default 5)")
+    g.add_argument("--lsl-timeout", type=float, default=2.0, metavar="S",
+                   help="seconds without a sample, once samples have come, after which the sender has failed: "
+                        f"reported, and exit status {SENDER_FAILED_STATUS} (default 2; 0: wait forever)")
     g.add_argument("--electrodes", default=None, metavar="E.csv|E.toml",
                    help="an electrode table: stimulation pulses go out on --lsl-pulses (docs/stimulation.md)")
     g.add_argument("--rule", default="biomimetic", choices=("biomimetic", "linear-amplitude", "linear-frequency"),
@@ -157,26 +177,6 @@ def stream(encoder, lines, out, err, scale=(1.0, 1.0, 1.0), sink=None, duration=
     return bad
 
 
-def _sites(text):
-    if text is None:
-        return None
-    if text == "fingertips":
-        from ddmm.population.stimuli.site_scenes import digit_tip_sites
-        return digit_tip_sites()
-    from ddmm.population.io import read_sites_csv
-    from ddmm.population.io.arrays import default_radius
-    from ddmm.population.stimuli.scenes import Sites
-
-    where, fields, _ = read_sites_csv(text)
-    radius = fields["radius_mm"]
-    if radius is None:
-        try:
-            radius = default_radius(fields["x_mm"], fields["y_mm"])
-        except ValueError as exc:
-            raise ValueError(f"{where}: {exc}") from None
-    return Sites(fields["x_mm"], fields["y_mm"], radius, region=fields["region"], site_id=fields["site"])
-
-
 @contextmanager
 def stop_on_signals():
     """A flag that SIGINT and SIGTERM set (instead of ending the process), for a clean stop."""
@@ -212,9 +212,13 @@ def run(args) -> int:
         raise ValueError(f"--duration must be > 0 s, got {args.duration:g}")
     if args.lsl_in is None and (args.lsl_source_id is not None):
         raise ValueError("--lsl-source-id goes with --lsl-in")
+    if args.lsl_out is None and args.lsl_spike_format is not None:
+        raise ValueError("--lsl-spike-format goes with --lsl-out")
     if (args.electrodes is None) != (args.lsl_pulses is None) or (args.electrodes and args.lsl_in is None):
         raise ValueError("--electrodes and --lsl-pulses go together, with --lsl-in")
-    sites = _sites(args.sites)
+    if args.lsl_timeout is not None and not args.lsl_timeout >= 0:  # NaN too
+        raise ValueError(f"--lsl-timeout must be >= 0 s (0: wait forever), got {args.lsl_timeout:g}")
+    sites = sites_option(args.sites)
     if args.lsl_in is not None or args.lsl_out is not None:
         quiet_liblsl(getattr(args, "debug", False))
     if args.lsl_in is not None:
@@ -237,9 +241,10 @@ def _spike_sink(args, encoder, force):
         return csv_sink(encoder, sys.stdout, force), None
     from ddmm.population.runtime.lsl_outlets import SpikeOutlet
 
-    outlet = SpikeOutlet(args.lsl_out, encoder, force=force)
+    outlet = SpikeOutlet(args.lsl_out, encoder, force=force, spike_format=args.lsl_spike_format or "events")
     print(f"ddmm: publishing spikes of {len(encoder.positions):,} afferents on LSL stream {args.lsl_out!r} "
-          f"(type Spikes, source id {outlet.source_id})", file=sys.stderr, flush=True)
+          f"(type Spikes, {outlet.spike_format.name} format, source id {outlet.source_id})", file=sys.stderr,
+          flush=True)
     return outlet.push, outlet
 
 
@@ -276,7 +281,8 @@ def _run_lsl(args, sites) -> int:
         bridge = Bridge(encoder, force, sink, report=lambda m: print(f"ddmm: {m}", file=sys.stderr, flush=True),
                         stimulator=stimulator, pulse_sink=None if pulses is None else pulses.push)
         with stop_on_signals() as should_stop:
-            summary = bridge.run(duration=args.duration, should_stop=should_stop)
+            summary = bridge.run(duration=args.duration, should_stop=should_stop,
+                                 timeout=args.lsl_timeout if args.lsl_timeout > 0 else None)
     finally:
         force.close()
     for stream_out in (outlet, pulses):
@@ -286,6 +292,6 @@ def _run_lsl(args, sites) -> int:
     if summary.samples == 0 and summary.stopped == "end of input":
         print("ddmm: the sender closed its stream before a sample reached us (it must wait for its consumer: "
               "LSL drops what an inlet has not pulled)", file=sys.stderr, flush=True)
-    return 0
+    return SENDER_FAILED_STATUS if summary.sender_failed else 0
 
 

@@ -101,6 +101,21 @@ class Engine:
         res = run_checked(current, substeps, dt, params, v, u, self, method, r, stacklevel=5)
         return res.afferent, res.step, res.state
 
+    def push(self, pipeline, forces, before, after, sample0, key, neuron_state, *, dt, method, parts=1, spare=None):
+        """One chunk of a streaming push: `advance`, with the filter state before read from ``before`` (left
+        as it is) and the state after written to ``after`` (an array of its shape; ``before`` itself: in
+        place), so a caller commits a chunk only when it succeeds without copying its state first.
+
+        ``spare`` is a `NeuronState` whose arrays an engine may overwrite
+        with the state after (the one returned); ``neuron_state`` is left
+        as it is.  This default copies ``before`` into ``after`` and calls
+        `advance`; the direct engine reads and writes in its kernels
+        (`ddmm.models.engines.direct_fused.push_fused`).
+        """
+        if after is not before:
+            after[...] = before
+        return self.advance(pipeline, forces, after, sample0, key, neuron_state, dt=dt, method=method, parts=parts)
+
     def __repr__(self) -> str:
         return f"<ddmm engine {self.name!r}>"
 
@@ -138,6 +153,13 @@ class DirectEngine(Engine):
         from .direct_fused import advance_fused
 
         return advance_fused(pipeline, forces, state, sample0, key, neuron_state, dt=dt, method=method, parts=parts)
+
+    def push(self, pipeline, forces, before, after, sample0, key, neuron_state, *, dt, method, parts=1, spare=None):
+        """A streaming chunk in two parallel regions that copy no state (`ddmm.models.engines.direct_fused.push_fused`)."""
+        from .direct_fused import push_fused
+
+        return push_fused(pipeline, forces, before, after, sample0, key, neuron_state, dt=dt, method=method,
+                          parts=parts, spare=spare)
 
 
 class Brian2Engine(Engine):

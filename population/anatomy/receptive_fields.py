@@ -52,8 +52,8 @@ from ddmm.utils.validation import as_finite_array, check_instance
 
 # RF_AREA_MM2 and RF_SIGMA_MM are views of the registry (the module's __getattr__).
 __all__ = ["RF_AREA_MM2", "RF_SIGMA_MM", "RF_SUPPORT", "RF_SHAPES", "RF_TAIL_FLOOR", "REFERENCE_AREA_MM2",  # noqa: F822
-           "receptive_field_weight", "population_weight", "site_weights", "local_mixing", "site_coverage",
-           "frame_theta"]
+           "receptive_field_weight", "population_weight", "site_weights", "local_mixing", "input_sections",
+           "site_coverage", "frame_theta"]
 
 
 
@@ -207,6 +207,21 @@ def local_mixing(x_mm, y_mm, afferent_type, sites, shape: str = "gaussian"):
     coeff = (w[rows, cols] / total[rows]) * factor[cols]
     indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=w.shape[0]))]).astype(np.int64)
     return indptr, cols.astype(np.int64), coeff, np.minimum(total, 1.0)
+
+
+def input_sections(sites, fs: float):
+    """{type code: filter sections} a multi-site scene's spread runs before each type's filters at ``fs`` Hz
+    (an indentation's transduction, `ddmm.population.stimuli.indentation.ContactSpread.input_sections`), or
+    None: the receptive fields and a spread without ``input_sections`` filter nothing.
+
+    Examples
+    --------
+    >>> input_sections(Sites([0.0], [0.0], 1.0), 1000.0) is None
+    True
+    """
+    check_instance(sites, "sites", Sites, "a Sites")
+    sections = getattr(sites.spread, "input_sections", None)
+    return None if sections is None else sections(fs) or None
 
 
 def site_coverage(population, sites) -> np.ndarray:

@@ -9,7 +9,8 @@
 - `distributed`: a run's afferent blocks as Dask tasks;
 - `lsl`, `lsl_outlets`, `lsl_bridge`: Lab Streaming Layer streams (forces in;
   spikes and pulses out) and the bridge between them and an `Encoder` (extra
-  ``ddmm[lsl]``).
+  ``ddmm[lsl]``); `spike_formats`: the spike stream's formats (one sample per
+  spike, or a frame per push) and their decoder, `decode_spikes`.
 """
 
 from ddmm.utils.lazy import lazy_exports
@@ -22,6 +23,7 @@ _WHERE = {
     "distributed": ("dask_client",),
     "lsl": ("ForceStream", "open_force_stream", "open_force_outlet", "lsl_clock"),
     "lsl_outlets": ("SpikeOutlet", "PulseOutlet", "read_spike_metadata"),
-    "lsl_bridge": ("Bridge", "BridgeSummary", "check_stamps", "play_forces"),
+    "spike_formats": ("SPIKE_FORMATS", "decode_spikes"),
+    "lsl_bridge": ("Bridge", "BridgeSummary", "check_stamps", "take_stamps", "play_forces"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

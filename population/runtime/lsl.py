@@ -127,41 +127,85 @@ def _channel_units_labels(info) -> tuple[list, list]:
     return units, labels
 
 
-def _stream_unit(name: str, declared: list, units: str | None) -> str:
+def _stream_unit(where: str, declared: list, units: str | None) -> str:
     """The unit: the one the stream declares (all channels alike) or the one given; they must agree."""
     names = {u for u in declared if u}
     unknown = sorted(u for u in names if u.lower() not in UNIT_NAMES)
     if unknown:
-        raise ValueError(f"LSL stream {name!r} declares the force unit {unknown[0]!r}; known: {', '.join(UNITS)}")
+        raise ValueError(f"{where} declares the force unit {unknown[0]!r}; known: {', '.join(UNITS)}")
     found = {UNIT_NAMES[u.lower()] for u in names}
     if len(found) > 1:
-        raise ValueError(f"LSL stream {name!r} declares mixed force units {sorted(found)}: one unit for all channels")
+        raise ValueError(f"{where} declares mixed force units {sorted(found)}: one unit for all channels")
     if units is not None and units not in UNITS:
         raise ValueError(f"units={units!r} is not allowed; allowed: {', '.join(UNITS)}")
     if units is not None and found and units not in found:
-        raise ValueError(f"LSL stream {name!r} declares its forces in {found.pop()}, not units={units!r}")
+        raise ValueError(f"{where} declares its forces in {found.pop()}, not units={units!r}")
     return units or (found.pop() if found else "N")
 
 
-def _check_labels(name: str, labels: list) -> None:
+def _check_labels(where: str, labels: list) -> None:
     """Channel labels that all name an axis (``Fx``, ``D2d_fz``, ``force_Y``) must run x, y, z per site."""
     axes = [re.search(r"([xyz])$", label.lower()) for label in labels]
     if not labels or not all(labels) or not all(axes):
         return
     for i, match in enumerate(axes):
         if match.group(1) != "xyz"[i % 3]:
-            raise ValueError(f"LSL stream {name!r}: channel {i} is labelled {labels[i]!r}, but channels must be "
+            raise ValueError(f"{where}: channel {i} is labelled {labels[i]!r}, but channels must be "
                              f"F_X, F_Y, F_Z of each site in turn (channel {i} is F_{'XYZ'[i % 3]})")
 
 
-def _stream_rate(name: str, nominal: float, fs: float | None) -> float:
+def _stream_rate(where: str, nominal: float, fs: float | None, fs_name: str = "fs") -> float:
     if nominal <= 0.0:
         if fs is None:
-            raise ValueError(f"LSL stream {name!r} has an irregular rate: give its sample rate (fs)")
-        return check_positive(fs, "fs", "Hz")
-    if fs is not None and abs(check_positive(fs, "fs", "Hz") - nominal) > 1e-3 * nominal:
-        raise ValueError(f"fs={float(fs):g} Hz disagrees with LSL stream {name!r}'s nominal rate {nominal:g} Hz")
+            raise ValueError(f"{where} has an irregular rate: give its sample rate ({fs_name})")
+        return check_positive(fs, fs_name, "Hz")
+    if fs is not None and abs(check_positive(fs, fs_name, "Hz") - nominal) > 1e-3 * nominal:
+        raise ValueError(f"{fs_name}={float(fs):g} Hz disagrees with the nominal rate {nominal:g} Hz of {where}")
     return float(nominal)
+
+
+def force_channel_labels(n_sites: int, site_ids=None) -> list:
+    """The channel labels of a force stream: ``Fx, Fy, Fz`` per site, as ``<site>_Fx, ...`` with ``site_ids``.
+
+    Examples
+    --------
+    >>> force_channel_labels(2, ["D2d", "D3d"])
+    ['D2d_Fx', 'D2d_Fy', 'D2d_Fz', 'D3d_Fx', 'D3d_Fy', 'D3d_Fz']
+    """
+    n_sites = check_count(n_sites, "n_sites")
+    sites = [str(s) for s in site_ids] if site_ids is not None else None
+    if sites is not None and len(sites) != n_sites:
+        raise ValueError(f"site_ids must name {n_sites} site(s), got {len(sites)}")
+    return [(f"{sites[site]}_" if sites else "") + f"F{axis}" for site in range(n_sites) for axis in "xyz"]
+
+
+def read_force_info(where: str, info, n_sites: int, fs: float | None, units: str | None,
+                    fs_name: str = "fs") -> tuple[float, str]:
+    """(sample rate in Hz, force unit) of a force stream's description, checked: the one reading of it.
+
+    A live stream's ``pylsl.StreamInfo`` and a recorded one's (an XDF stream
+    header, `ddmm.population.io.xdf`) go through here alike: the channel count
+    (``3 n_sites``), a numeric format, the rate (``fs`` for an irregular
+    stream), the declared unit and the axis labels (``desc/channels``).
+    ``info`` answers ``channel_count()``, ``channel_format()`` (liblsl's
+    code), ``nominal_srate()`` and ``desc()`` as pylsl's does; ``where``
+    names the stream in the errors, ``fs_name`` the argument that gives ``fs``.
+
+    Examples
+    --------
+    >>> read_force_info("LSL stream 'glove'", stream_info, 1, None, None)  # doctest: +SKIP
+    (1000.0, 'mN')
+    """
+    if info.channel_count() != 3 * n_sites:
+        raise ValueError(f"{where} has {info.channel_count()} channels; {n_sites} site(s) need "
+                         f"{3 * n_sites} (F_X, F_Y, F_Z per site)")
+    if info.channel_format() not in _NUMERIC:
+        raise ValueError(f"{where} carries strings, not forces (a numeric channel format is needed)")
+    rate = _stream_rate(where, float(info.nominal_srate()), fs, fs_name)
+    declared, labels = _channel_units_labels(info)
+    unit = _stream_unit(where, declared, units)
+    _check_labels(where, labels)
+    return rate, unit
 
 
 def open_force_stream(name: str, *, n_sites: int = 1, fs: float | None = None, units: str | None = None,
@@ -210,18 +254,9 @@ def open_force_stream(name: str, *, n_sites: int = 1, fs: float | None = None, u
     if fz_sign not in (1, -1):
         raise ValueError(f"fz_sign must be 1 or -1, got {shown(fz_sign)}")
     found = _resolve(pylsl, name, source_id, timeout)
-    if found.channel_count() != 3 * n_sites:
-        raise ValueError(f"LSL stream {name!r} has {found.channel_count()} channels; {n_sites} site(s) need "
-                         f"{3 * n_sites} (F_X, F_Y, F_Z per site)")
-    if found.channel_format() not in _NUMERIC:
-        raise ValueError(f"LSL stream {name!r} carries strings, not forces (a numeric channel format is needed)")
-    rate = _stream_rate(name, found.nominal_srate(), fs)
     inlet = pylsl.StreamInlet(found, max_buflen=360, recover=False)
     try:
-        full = inlet.info(timeout=timeout)
-        declared, labels = _channel_units_labels(full)
-        unit = _stream_unit(name, declared, units)
-        _check_labels(name, labels)
+        rate, unit = read_force_info(f"LSL stream {name!r}", inlet.info(timeout=timeout), int(n_sites), fs, units)
         # Ask once now: the first correction takes a few exchanges, and a pull waiting on it would stall.
         offset = inlet.time_correction(timeout=timeout)
     except Exception:
@@ -253,18 +288,15 @@ def open_force_outlet(name: str, *, fs: float, n_sites: int = 1, units: str = "N
     pylsl = _pylsl("open_force_outlet")
     if units not in UNITS:
         raise ValueError(f"units={units!r} is not allowed; allowed: {', '.join(UNITS)}")
-    sites = [str(s) for s in site_ids] if site_ids is not None else None
-    if sites is not None and len(sites) != n_sites:
-        raise ValueError(f"site_ids must name {n_sites} site(s), got {len(sites)}")
+    labels = force_channel_labels(n_sites, site_ids)
     sid = source_id or "ddmm-force-" + hashlib.sha256(f"{name}/{fs}/{n_sites}/{units}".encode()).hexdigest()[:12]
     info = pylsl.StreamInfo(name, FORCE_STREAM_TYPE, 3 * n_sites, rate, pylsl.cf_double64, sid)
     channels = info.desc().append_child("channels")
-    for site in range(n_sites):
-        for axis in "xyz":
-            channel = channels.append_child("channel")
-            channel.append_child_value("label", (f"{sites[site]}_" if sites else "") + f"F{axis}")
-            channel.append_child_value("unit", units)
-            channel.append_child_value("type", "Force")
+    for label in labels:
+        channel = channels.append_child("channel")
+        channel.append_child_value("label", label)
+        channel.append_child_value("unit", units)
+        channel.append_child_value("type", "Force")
     info.desc().append_child("acquisition").append_child_value("manufacturer", "ddmm")
     return pylsl.StreamOutlet(info)
 

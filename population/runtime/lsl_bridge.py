@@ -16,11 +16,21 @@ skipped and reported, and counted as a one-sample gap.
 The bridge stops at the end of input (the sender withdraws its stream: LSL
 then discards what the inlet has not pulled, so a sender should close only
 once the bridge has caught up), when ``should_stop()`` turns true (a signal
-handler's flag), or after ``duration`` seconds of input.
+handler's flag), or after ``duration`` seconds of input.  It stops on a
+**sender that failed** too, reported with the time since its last sample:
+no sample for ``timeout`` seconds once samples have come (a sender hung, or
+a host or link gone), or the stream withdrawn less than `QUIET_END_S` after
+its last sample, while samples were coming (a sender killed or crashed:
+liblsl cannot tell that from a close, so a sender ends its input by going
+quiet first, as it must anyway for the bridge to catch up).
+
+The stamp rule is `take_stamps`, which a recorded stream (an XDF file,
+`ddmm.population.io.xdf`) goes through as well.
 """
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -29,10 +39,17 @@ import numpy as np
 from ddmm.population.runtime.lsl import ChunkReader, ForceStream, _pylsl
 from ddmm.utils.validation import as_float_array, check_instance, check_positive, check_real
 
-__all__ = ["GAP_FACTOR", "BridgeSummary", "Bridge", "check_stamps", "play_forces"]
+__all__ = ["GAP_FACTOR", "QUIET_END_S", "SENDER_FAILED", "BridgeSummary", "Bridge", "check_stamps", "take_stamps",
+           "play_forces"]
 
 #: An interval between stamps over this many sample periods is a gap (as for recorded streams).
 GAP_FACTOR = 1.5
+#: A stream withdrawn less than this many seconds after its last sample was lost mid-stream (its sender
+#: killed or crashed, or closed while sending); withdrawn after a longer quiet spell, its input ended.
+QUIET_END_S = 0.5
+#: The ``BridgeSummary.stopped`` values of a sender that failed: no sample within the timeout, or its
+#: stream lost mid-stream.
+SENDER_FAILED = ("sender silent", "sender lost")
 
 
 @dataclass
@@ -48,7 +65,13 @@ class BridgeSummary:
     out_of_order, skipped : int
         Samples dropped for stamps that do not increase; samples the encoder refused.
     stopped : str
-        ``"end of input"``, ``"duration"``, ``"stopped"`` (``should_stop``) or ``""`` while running.
+        ``"end of input"``, ``"duration"``, ``"stopped"`` (``should_stop``), a
+        failed sender (`SENDER_FAILED`: ``"sender silent"``, no sample within
+        the timeout; ``"sender lost"``, its stream withdrawn mid-stream) or
+        ``""`` while running.
+    quiet_s : float
+        With a failed sender, the seconds since its last sample when the
+        bridge stopped.
     """
 
     samples: int = 0
@@ -58,6 +81,12 @@ class BridgeSummary:
     out_of_order: int = 0
     skipped: int = 0
     stopped: str = ""
+    quiet_s: float = 0.0
+
+    @property
+    def sender_failed(self) -> bool:
+        """Whether the bridge stopped on a sender that failed (`SENDER_FAILED`)."""
+        return self.stopped in SENDER_FAILED
 
     def describe(self) -> str:
         """One line for a log."""
@@ -114,6 +143,75 @@ def check_stamps(stamps, last: float | None, fs: float):
     return keep, excess
 
 
+def take_stamps(stamps, last: float | None, fs: float, summary: BridgeSummary, report, *, limit: int | None = None,
+                clock_offset_s: float = 0.0):
+    """The stamp rule on a chunk, with its record and reports: what a live and a recorded stream share.
+
+    `check_stamps` decides; each out-of-order sample is counted in
+    ``summary.out_of_order`` and reported, each gap appended to
+    ``summary.gaps`` (the stamp before it plus ``clock_offset_s``, and its
+    length) and reported.  The kept samples are taken as consecutive.
+
+    Parameters
+    ----------
+    stamps : array_like, shape (n,)
+        The chunk's stamps in seconds (sender's clock).
+    last : float or None
+        Stamp of the last sample kept before this chunk (None: the first chunk).
+    fs : float
+        Sample rate in Hz.
+    summary : BridgeSummary
+        Where the counts and gaps go.
+    report : callable
+        ``report(message)``, one line for each out-of-order sample and gap.
+    limit : int, optional
+        The most samples to keep (the rest of the chunk is left).
+    clock_offset_s : float
+        Added to the gaps' stamps in ``summary`` (a live stream's offset to this host's clock).
+
+    Returns
+    -------
+    index : ndarray of int
+        Positions in the chunk of the samples kept, in order.
+    runs : list of (int, int, float)
+        ``(start, stop, excess)`` into ``index``: runs of consecutive samples,
+        each after a gap whose length exceeds one period by ``excess`` s (0
+        for the first run when no gap precedes it).
+
+    Examples
+    --------
+    >>> summary, lines = BridgeSummary(), []
+    >>> index, runs = take_stamps([0.001, 0.002, 0.0015, 0.010], 0.0, 1000.0, summary, lines.append)
+    >>> index.tolist(), [(a, b, round(e, 6)) for a, b, e in runs], summary.out_of_order, len(summary.gaps)
+    ([0, 1, 3], [(0, 2, 0.0), (2, 3, 0.007)], 1, 1)
+    """
+    check_instance(summary, "summary", BridgeSummary, "a BridgeSummary")
+    if not callable(report):
+        raise TypeError(f"report must be callable (report(message)), got {type(report).__name__}")
+    keep, excess = check_stamps(stamps, last, fs)
+    stamps = np.asarray(stamps, dtype=float)
+    for i in np.flatnonzero(~keep):
+        summary.out_of_order += 1
+        report(f"a sample stamped {stamps[i]:.6f} s comes at or before the one before it: dropped")
+    index = np.flatnonzero(keep)
+    if limit is not None:
+        index = index[:max(limit, 0)]
+    if index.size == 0:
+        return index, []
+    gaps = excess[index]
+    starts = sorted({0, *np.flatnonzero(gaps > 0).tolist()}) + [index.size]
+    period = 1.0 / float(fs)
+    runs = []
+    for a, b in zip(starts[:-1], starts[1:]):
+        if gaps[a] > 0:
+            before = float(stamps[index[a]]) - float(gaps[a]) - period  # the stamp of the sample before the gap
+            summary.gaps.append((before + clock_offset_s, float(gaps[a]) + period))
+            report(f"a gap of {float(gaps[a]) + period:.6g} s after the sample stamped {before:.6f} s; "
+                   "the samples are taken as consecutive and the spike stamps move on by the gap")
+        runs.append((a, b, float(gaps[a])))
+    return index, runs
+
+
 class Bridge:
     """Pull force samples from an LSL stream, encode them, and send the spikes on.
 
@@ -162,6 +260,8 @@ class Bridge:
         self._shape = (3,) if encoder.sites is None else (n_sites, 3)
         self._scale, self._gap_s = force.scale, GAP_FACTOR / force.fs  # made once: used for every sample
         self._reader = None  # the inlet's ChunkReader, made at the first poll
+        _settle_garbage_collector()  # here, before the inlet opens: a collection takes tens of ms
+        self._arrival = None  # time.monotonic() of the last pull that brought samples
 
     def poll(self, timeout: float = 0.05, limit: int | None = None) -> int:
         """Pull what has arrived (waiting up to ``timeout`` s for a first sample) and encode it.
@@ -174,6 +274,7 @@ class Bridge:
         samples, stamps = self._reader.pull(timeout)
         if len(stamps) == 0:
             return 0
+        self._arrival = time.monotonic()
         return self.consume(np.asarray(samples, float), np.asarray(stamps, float), limit)
 
     def consume(self, samples, stamps, limit: int | None = None) -> int:
@@ -184,23 +285,15 @@ class Bridge:
             self._last = float(stamps[-1])
             self.summary.samples += n
             return n
-        keep, excess = check_stamps(stamps, self._last, self.force.fs)
-        for i in np.flatnonzero(~keep):
-            self.summary.out_of_order += 1
-            self.report(f"a sample stamped {stamps[i]:.6f} s comes at or before the one before it: dropped")
-        index = np.flatnonzero(keep)
-        if limit is not None:
-            index = index[:max(limit, 0)]
+        index, runs = take_stamps(stamps, self._last, self.force.fs, self.summary, self.report, limit=limit,
+                                  clock_offset_s=self.force.clock_offset_s)
         if index.size == 0:
             return 0
         if self._anchor is None:
             self._anchor = float(stamps[index[0]]) + self.force.clock_offset_s
         forces = samples[index] * self._scale
-        gaps = excess[index]
-        starts = sorted({0, *np.flatnonzero(gaps > 0).tolist()}) + [index.size]
-        for a, b in zip(starts[:-1], starts[1:]):
-            if gaps[a] > 0:
-                self._gap(float(stamps[index[a]]), float(gaps[a]))
+        for a, b, excess in runs:
+            self._anchor += excess  # the spikes after a gap move on by its excess
             self._push(forces[a:b])
         self._last = float(stamps[index[-1]])
         self.summary.samples += index.size
@@ -221,13 +314,6 @@ class Bridge:
             return True
         steps = np.diff(stamps)
         return bool(np.all(steps > 0.0) and np.all(steps <= self._gap_s))
-
-    def _gap(self, stamp: float, excess: float) -> None:
-        before = stamp - excess - 1.0 / self.force.fs  # the stamp of the sample before the gap
-        self.summary.gaps.append((before + self.force.clock_offset_s, excess + 1.0 / self.force.fs))
-        self.report(f"a gap of {excess + 1.0 / self.force.fs:.6g} s after the sample stamped {before:.6f} s; "
-                    "the samples are taken as consecutive and the spike stamps move on by the gap")
-        self._anchor += excess
 
     def _push(self, forces) -> None:
         forces = forces.reshape((-1, *self._shape))
@@ -254,13 +340,28 @@ class Bridge:
             self.sink(spikes.afferent, self._anchor + spikes.time)
             self.summary.spikes += int(spikes.afferent.size)
 
-    def run(self, *, duration: float | None = None, should_stop=None, poll_s: float = 0.05) -> BridgeSummary:
-        """Bridge until the end of input, ``should_stop()``, or ``duration`` seconds of input.
+    def run(self, *, duration: float | None = None, should_stop=None, poll_s: float = 0.05,
+            timeout: float | None = None) -> BridgeSummary:
+        """Bridge until the end of input, ``should_stop()``, ``duration`` seconds of input, or a failed sender.
 
-        Returns the `BridgeSummary` (also kept as ``summary``).
+        ``timeout`` (s; None: wait forever) is the longest wait for a sample
+        once samples have come: past it the sender has failed (``"sender
+        silent"``); before the first sample the bridge waits (a sender may
+        publish its stream before its device starts).  A stream withdrawn
+        less than `QUIET_END_S` after its last sample failed too (``"sender
+        lost"``); either is reported (``report``) with the stream's name and
+        the time since its last sample.  Returns the `BridgeSummary` (also
+        kept as ``summary``).
+
+        Examples
+        --------
+        >>> summary = bridge.run(timeout=2.0)  # doctest: +SKIP
+        >>> summary.stopped, summary.sender_failed  # doctest: +SKIP
+        ('sender silent', True)
         """
         lost = _pylsl("Bridge.run").util.LostError
         limit = None if duration is None else int(round(check_positive(duration, "duration", "s") * self.force.fs))
+        timeout = None if timeout is None else check_positive(timeout, "timeout", "s")
         try:
             self.force.open()
         except lost:
@@ -276,9 +377,40 @@ class Bridge:
             try:
                 self.poll(poll_s, None if limit is None else limit - self.summary.samples)
             except lost:
-                self.summary.stopped = "end of input"
+                quiet = math.inf if self._arrival is None else time.monotonic() - self._arrival
+                if quiet < QUIET_END_S:
+                    self._failed("sender lost", quiet, f"was lost {quiet:.3g} s after its last sample, while "
+                                 "samples were coming: its sender died (or closed its stream mid-stream)")
+                else:
+                    self.summary.stopped = "end of input"
+                break
+            if timeout is not None and self._arrival is not None and time.monotonic() - self._arrival >= timeout:
+                quiet = time.monotonic() - self._arrival
+                self._failed("sender silent", quiet, f"sent no sample for {quiet:.3g} s since its last one (the "
+                             f"timeout is {timeout:g} s): its sender has stopped")
                 break
         return self.summary
+
+    def _failed(self, stopped: str, quiet: float, what: str) -> None:
+        self.summary.stopped, self.summary.quiet_s = stopped, float(quiet)
+        self.report(f"LSL stream {self.force.name!r} {what}")
+
+
+_SETTLED = []  # whether this process's garbage collector was settled (`_settle_garbage_collector`)
+
+
+def _settle_garbage_collector() -> None:
+    """Once a process: collect, then move every object alive (the model, its tables, the modules) out of
+    the cyclic collector's reach (`gc.freeze`).  A full collection walked them all mid-stream, ~45 ms with
+    the hand's model loaded (measured, twice in 3 s), while samples queued up; from here on it walks only
+    what came after."""
+    if _SETTLED:
+        return
+    import gc
+
+    gc.collect()
+    gc.freeze()
+    _SETTLED.append(True)
 
 
 def play_forces(outlet, forces, fs: float, *, should_stop=None, start: float | None = None) -> int:

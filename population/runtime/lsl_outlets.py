@@ -2,16 +2,20 @@
 
 Needs the optional extra ``ddmm[lsl]``.
 
-**The spike stream** (`SpikeOutlet`): type ``Spikes``, one int32 channel,
-irregular rate; **one sample per spike, holding the afferent's id** (the
-``afferent`` coordinate of `simulate`'s Dataset), **stamped with the spike's
-time on the input stream's clock**: the capture stamp of the first force
-sample, mapped to this host's LSL clock, plus the spike's model time (a
-reported gap in the input moves the anchor by the gap's length,
+**The spike stream** (`SpikeOutlet`): type ``Spikes``, int32 channels,
+irregular rate.  Each spike is **the afferent's id** (the ``afferent``
+coordinate of `simulate`'s Dataset) **stamped with the spike's time on the
+input stream's clock**: the capture stamp of the first force sample, mapped
+to this host's LSL clock, plus the spike's model time (a reported gap in the
+input moves the anchor by the gap's length,
 `ddmm.population.runtime.lsl_bridge`).  Spikes of one step go out in
-increasing id.  Its meta-data (`read_spike_metadata`) describe the
-population (id, type, position, region, theta_T and NAP of each afferent),
-the model settings and the input stream.
+increasing id.  In the default format, ``events``, one LSL sample is one
+spike; in ``batched``, one sample is a frame of a push's spikes, which
+`decode_spikes` turns back into the same ids and stamps, bit for bit
+(`ddmm.population.runtime.spike_formats`).  Its meta-data
+(`read_spike_metadata`) give the format and describe the population (id,
+type, position, region, theta_T and NAP of each afferent), the model
+settings and the input stream.
 
 **The pulse stream** (`PulseOutlet`): type ``StimulationPulses``, the
 pulses of a `StimulationEncoder` (docs/stimulation.md).
@@ -28,9 +32,10 @@ import hashlib
 import numpy as np
 
 from ddmm.population.runtime.lsl import PULSE_STREAM_TYPE, SPIKE_STREAM_TYPE, ForceStream, _handle_error, _pylsl
+from ddmm.population.runtime.spike_formats import SPIKE_FORMATS, decode_spikes
 from ddmm.utils.validation import check_instance
 
-__all__ = ["SpikeOutlet", "PulseOutlet", "read_spike_metadata"]
+__all__ = ["PulseOutlet", "SpikeOutlet", "decode_spikes", "read_spike_metadata"]
 
 
 def _text(values, fmt=str) -> str:
@@ -52,6 +57,10 @@ class SpikeOutlet:
     source_id : str, optional
         Default: derived from ``name``, the population and the seed, so a
         restarted bridge keeps its id and recorders reconnect to it.
+    spike_format : str
+        A name in `SPIKE_FORMATS`: ``"events"`` (default, one sample per
+        spike) or ``"batched"`` (one frame per push: what keeps the whole
+        hand at 1 kHz, docs/live-sensors.md).
 
     Examples
     --------
@@ -60,40 +69,49 @@ class SpikeOutlet:
     >>> outlet = SpikeOutlet("ddmm-doc-spikes", Encoder(make_population(["SAI"]), fs=1000.0))  # doctest: +SKIP
     """
 
-    def __init__(self, name: str, encoder, *, force: ForceStream | None = None, source_id: str | None = None):
+    def __init__(self, name: str, encoder, *, force: ForceStream | None = None, source_id: str | None = None,
+                 spike_format: str = "events"):
         from ddmm.population.runtime.stream import Encoder
 
         check_instance(name, "name", str, "a str (the stream's LSL name)")
         check_instance(encoder, "encoder", Encoder, "an Encoder")
         check_instance(force, "force", (ForceStream, type(None)), "a ForceStream or None")
+        if not isinstance(spike_format, str) or spike_format not in SPIKE_FORMATS:
+            raise ValueError(f"spike_format must be one of {', '.join(SPIKE_FORMATS)}, got {spike_format!r}")
         pylsl = _pylsl("SpikeOutlet")
+        fmt = self.spike_format = SPIKE_FORMATS[spike_format]
         ids = encoder.population.afferent_id[encoder.positions]
         digest = hashlib.sha256(f"{name}/{encoder.population.name}/{encoder.seed}/{_text(ids)}".encode())
         self.source_id = source_id or "ddmm-spikes-" + digest.hexdigest()[:12]
-        info = pylsl.StreamInfo(name, SPIKE_STREAM_TYPE, 1, pylsl.IRREGULAR_RATE, pylsl.cf_int32, self.source_id)
-        _describe(info.desc(), encoder, force)
+        info = pylsl.StreamInfo(name, SPIKE_STREAM_TYPE, fmt.channels, pylsl.IRREGULAR_RATE, pylsl.cf_int32,
+                                self.source_id)
+        _describe(info.desc(), encoder, force, fmt)
         self.name = name
         self._ids = encoder.population.afferent_id.astype(np.int32)
-        # An irregular stream's buffer counts hundreds of samples: 360,000 spikes for a slow consumer.
-        self._outlet = pylsl.StreamOutlet(info, max_buffered=3600)
+        self._pack = fmt.pack
+        self._pack(self._ids[:1], np.zeros(1))  # compiled (or loaded) now, not at the first spike
+        # An irregular stream's buffer counts hundreds of samples: events, 360,000 spikes for a slow consumer.
+        self._outlet = pylsl.StreamOutlet(info, max_buffered=fmt.max_buffered)
         push_n, handle = getattr(self._outlet, "do_push_chunk_n", None), _handle_error()
         # Looked up once: a push is on the latency path, once per force sample.
         self._push_n = None if push_n is None or handle is None else (push_n, self._outlet.obj, handle)
 
     def push(self, positions, stamps) -> None:
         """Send spikes: the afferents' positions in the encoder's population and their LSL stamps (s)."""
-        ids = np.ascontiguousarray(self._ids[np.asarray(positions)])
-        if ids.size == 0:
+        positions = np.asarray(positions)
+        if positions.size == 0:
             return
+        ids = np.ascontiguousarray(self._ids[positions])
         stamps = np.ascontiguousarray(stamps, dtype=np.float64)
         if stamps.shape != ids.shape:
             raise ValueError(f"stamps must have one entry per spike; got {stamps.size} for {ids.size}")
+        samples, stamps = self._pack(ids, stamps)  # the format's samples: one per spike, or frames
         if self._push_n is None:  # another pylsl: its public call, which copies the stamps to a list
-            self._outlet.push_chunk(ids[:, None], stamps.tolist())
+            self._outlet.push_chunk(samples, stamps.tolist())
             return
         # pylsl's own call on the arrays as they are: a burst of 10,000 spikes costs liblsl ~2 ms, the list 1 ms more
         push_n, obj, handle = self._push_n
-        handle(push_n(obj, ctypes.c_void_p(ids.ctypes.data), ctypes.c_long(ids.size),
+        handle(push_n(obj, ctypes.c_void_p(samples.ctypes.data), ctypes.c_long(samples.size),
                       ctypes.c_void_p(stamps.ctypes.data), ctypes.c_int(1)))
 
     def have_consumers(self) -> bool:
@@ -159,16 +177,25 @@ class PulseOutlet:
         del self._outlet
 
 
-def _describe(desc, encoder, force) -> None:
-    """The spike stream's meta-data: the channel, the convention, the model, the input and the population."""
+def _describe(desc, encoder, force, spike_format) -> None:
+    """The spike stream's meta-data: the format, the channels, the convention, the model, the input and the
+    population.  A batched stream describes its frame's fields, not its 2,048 channels one by one."""
     from ddmm import __version__
 
-    channel = desc.append_child("channels").append_child("channel")
-    channel.append_child_value("label", "afferent_id")
-    channel.append_child_value("type", "SpikeID")
-    channel.append_child_value("unit", "1")
-    desc.append_child_value("convention", "one sample per spike: the afferent id; stamp: the spike time on the "
-                            "input stream's clock (first sample's stamp + model time, moved on by reported gaps)")
+    desc.append_child_value("format", spike_format.name)
+    channels = desc.append_child("channels")
+    for label in spike_format.labels:
+        channel = channels.append_child("channel")
+        channel.append_child_value("label", label)
+        channel.append_child_value("type", "SpikeID" if label == "afferent_id" else "SpikeFrame")
+        channel.append_child_value("unit", "1")
+    if spike_format.channels > 1:
+        frame = desc.append_child("frame")
+        for key, value in (("capacity", str(spike_format.channels)),
+                           ("layout", "count,stamp_hi,stamp_lo,afferent_id*count"), ("padding", "-1"),
+                           ("stamp_bits", "IEEE-754 binary64, high word then low word, as int32")):
+            frame.append_child_value(key, value)
+    desc.append_child_value("convention", spike_format.convention)
     model = desc.append_child("model")
     settings = {"software": f"ddmm {__version__}", "population": encoder.population.name, "seed": str(encoder.seed),
                 "engine": encoder.engine, "method": encoder.method, "dt_s": repr(encoder.dt),
@@ -204,21 +231,26 @@ def read_spike_metadata(info) -> dict:
     Returns
     -------
     dict
-        ``afferents``: a dict of arrays (``id``, ``type``, ``x_mm``, ``y_mm``,
-        ``region``, ``theta_t_deg``, ``nap``), one entry per afferent; ``model``
-        and ``input``: dicts of strings; ``sites`` (when the encoder has sites).
+        ``format``: the stream's format, a name in `SPIKE_FORMATS` for
+        `decode_spikes` (``"events"`` for a stream that states none: ddmm
+        before the batched format); ``afferents``: a dict of arrays (``id``,
+        ``type``, ``x_mm``, ``y_mm``, ``region``, ``theta_t_deg``, ``nap``),
+        one entry per afferent; ``model`` and ``input``: dicts of strings;
+        ``sites`` (when the encoder has sites).
 
     Examples
     --------
     >>> inlet = pylsl.StreamInlet(pylsl.resolve_byprop("type", "Spikes")[0])  # doctest: +SKIP
     >>> meta = read_spike_metadata(inlet.info())  # doctest: +SKIP
+    >>> samples, stamps = inlet.pull_chunk(timeout=1.0, max_samples=4096, as_numpy=True)  # doctest: +SKIP
+    >>> ids, stamps = decode_spikes(samples, stamps, meta["format"])  # either format  # doctest: +SKIP
     """
     if not callable(getattr(info, "desc", None)):
         raise TypeError(f"info must be a pylsl.StreamInfo (e.g. inlet.info()), got {type(info).__name__}")
     desc = info.desc()
     if desc.child("afferents").empty():
         raise ValueError(f"LSL stream {info.name()!r} carries no ddmm population description")
-    out = {}
+    out = {"format": desc.child_value("format") or "events"}
     for block in ("model", "input"):
         node, values = desc.child(block), {}
         child = node.first_child()

@@ -9,19 +9,23 @@ concatenated spikes of *any* chunking equal the offline run of the whole
 signal with the same seed, bit for bit, with no noise drawn ahead, no
 background thread and no queue.  An engine may integrate a push in
 parallel (`Engine.stream_parts`): the direct engine, from
-``DirectEngine.parallel_min_afferents`` afferents, integrates its neurons on every core (``DDMM_NUM_THREADS``) in one
-numba parallel region; neurons are independent, so no spike changes.
+``DirectEngine.parallel_min_afferents`` afferents, runs a push on every core (``DDMM_NUM_THREADS``) in two
+numba parallel regions (the front pass, then the back pass and the neurons, around numpy's log1p and tanh;
+`Engine.push`); afferents are independent, so no spike changes.  A push copies no state: with forward Euler it
+updates the state in place, otherwise it writes spare buffers that a success swaps in.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 
 from ddmm.models.attenuation import NO_SHEAR_READINGS
 from ddmm.models.current_filters import check_fs
-from ddmm.models.engines import METHODS, get_engine, substeps_for
+from ddmm.models.engines import METHODS, NeuronState, get_engine, substeps_for
 from ddmm.population.anatomy.receptive_fields import population_weight, site_coverage
 from ddmm.population.runtime.noise import noise_key, root_seed
 from ddmm.population.sampling import Population
@@ -139,10 +143,12 @@ class Encoder:
                             f"{type(sites).__name__} with contact={contact!r}")
         self.seed, self.contact = root_seed(seed), contact
         self.sites = sites
+        self._shape = (3,) if sites is None else (len(sites), 3)  # a sample's shape
+        self._allowance = 0.0 if conditioning is None else noise_allowance(conditioning)
         idx = _type_positions(population, afferent_types)
         check_fs(self.model_fs, population.current, tuple(np.unique(population.afferent_type[idx])))
         self._order = idx[_grouped(population, idx, np.arange(idx.size))]  # contiguous (type, NAP) groups, as offline
-        self.population = population
+        self.population, self._positions = population, len(population)
         self._pop = population.select(self._order)
         self._precompute()
         self._engine.prepare()
@@ -157,14 +163,24 @@ class Encoder:
         elif self.sites is not None:
             scale = pop.gain * site_coverage(pop, self.sites)
         self._pipeline = block_pipeline(pop, self.model_fs, self.sites, scale, self.no_shear)
+        # Forward Euler refuses no chunk it was given (no stability check; the v floor and the bounded drive keep
+        # it finite), so its pushes write the state in place: a copy of the state costs more than the kernels'
+        # own sweep of it (the hand: ~1.5 MB a push, out of cache).  The other methods' stability check may
+        # refuse a chunk after it ran: theirs write spare buffers, committed when the chunk succeeds.
+        self._in_place = self.method == "euler"
         # Read once: a push is latency-bound, and the thread count is fixed for the encoder's life.
         self._parts = self._engine.stream_parts(len(pop))
         noisy = np.any(pop.noise_sigma > 0) or np.any(pop.noise_cv > 0) or self._pipeline.excite_any
         self._key = noise_key(self.seed, 0, 0) if noisy else None
+        # The neurons before the first sample (SA-II's phases drawn): made once, copied at each reset.
+        self._initial = self._pipeline.initial_membrane(None, self._key)
 
     def reset(self) -> None:
         """Back to the start: filters at rest on the next sample, neurons at rest, noise from sample 0."""
-        self._state, self._neuron_state, self._samples, self._last_time = self._pipeline.new_state(), None, 0, None
+        self._state, self._samples, self._last_time = self._pipeline.new_state(), 0, None
+        self._neuron_state = NeuronState(*(x.copy() for x in self._initial))
+        # What the next push writes, swapped in when it succeeds (a push in place writes the state itself).
+        self._spare, self._lost = (None, None) if self._in_place else (np.empty_like(self._state), None), None
         self._conditioner = None if self.conditioning is None else Conditioner(
             self.conditioning, self.fs, self.model_fs, None if self.sites is None else len(self.sites))
 
@@ -213,6 +229,11 @@ class Encoder:
         return self._samples
 
     def _validate(self, forces, times):
+        if times is None and type(forces) is np.ndarray and forces.dtype == np.float64 and forces.flags.c_contiguous \
+                and forces.shape[1:] == self._shape and forces.shape[0]:  # a live push: one pass checks it all
+            finite, peak, fz_min = _summary(forces.reshape(-1, 3))
+            if finite and peak * math.sqrt(3.0) <= self.max_force_n and fz_min >= -self._allowance:
+                return forces, None  # else the checks below say what is wrong
         forces = as_finite_array(forces, "forces")
         if self.sites is not None:
             if forces.ndim != 3 or forces.shape[1:] != (len(self.sites), 3):
@@ -253,6 +274,12 @@ class Encoder:
             For non-finite values, a negative normal force, a force beyond
             ``max_force_n``, a wrong shape or time going backwards; the
             encoder's state is left untouched.
+        NumericalInstabilityError
+            When the integration refuses the chunk (an explicit method's
+            stability check, or a non-finite state): with ``method="euler"``,
+            whose pushes update the state in place, the state is then lost
+            and every later push raises until `reset`; with the other
+            methods it is left untouched.
         """
         forces, times = self._validate(forces, times)
         if self._conditioner is not None:
@@ -260,20 +287,87 @@ class Encoder:
         n = forces.shape[0]
         if n == 0:
             return StreamSpikes(np.empty(0, np.int64), np.empty(0), forces)
-        state = self._state.copy()  # committed only if the whole chunk succeeds
-        afferent, step, neuron_state = self._pipeline.advance(forces, state, self._samples, self._key,
-                                                              self._neuron_state, dt=self.dt, method=self.method,
-                                                              engine=self._engine, parts=self._parts)
+        if self._lost is not None:
+            raise ValueError(f"a push failed after it had changed the encoder's state ({self._lost}): reset() first")
+        # The engine reads the state and writes the spare buffers, swapped in if the whole chunk succeeds; or, in
+        # place, writes the state itself (a failure then loses it).
+        state, spare = (self._state, self._neuron_state) if self._in_place else self._spare
+        try:
+            afferent, step, neuron_state = self._engine.push(self._pipeline, forces, self._state, state,
+                                                             self._samples, self._key, self._neuron_state, dt=self.dt,
+                                                             method=self.method, parts=self._parts, spare=spare)
+        except BaseException as exc:
+            if self._in_place:
+                self._lost = f"{type(exc).__name__}: {exc}"
+            raise
         step0 = self._samples * self.substeps
+        if not self._in_place:
+            self._spare = (self._state, self._neuron_state)
         self._state, self._neuron_state = state, neuron_state
         self._samples += n
         if times is not None:
             self._last_time = float(times[-1])
-        afferent, step = self._order[afferent], step + step0
-        if afferent.size > 1:
-            order = np.lexsort((afferent, step))
-            afferent, step = afferent[order], step[order]
-        return StreamSpikes(afferent, step * self.dt, forces)
+        afferent, time = _in_order(afferent, step, self._order, self._positions, step0, self.dt)
+        return StreamSpikes(afferent, time, forces)
+
+
+@nb.njit(cache=True, nogil=True)
+def _summary(forces):
+    """(all finite, largest |component|, smallest F_Z) of samples (n, 3), in one pass."""
+    finite, peak, fz_min = True, 0.0, np.inf
+    for i in range(forces.shape[0]):
+        for k in range(3):
+            x = forces[i, k]
+            finite &= math.isfinite(x)
+            peak = max(peak, abs(x))
+        fz_min = min(fz_min, forces[i, 2])
+    return finite, peak, fz_min
+
+
+@nb.njit(cache=True, nogil=True)
+def _in_order(idx, stp, order, n, step0, dt):
+    """Spikes (columns ``idx``, steps ``stp`` within the chunk) as (position in the population, time in s),
+    sorted by time, then position: ``order[idx]`` and ``(stp + step0) dt``.
+
+    A neuron spikes at most once a step, so the keys ``(step - first) n +
+    position`` (``n`` positions) are distinct and their order is the one
+    wanted: a push spans a few steps, so they fit a few 11-bit digits, sorted
+    digit by digit (an LSD radix sort, a pass over the spikes each);
+    a chunk of many steps sorts them at once.
+    """
+    m = idx.size
+    positions, time = np.empty(m, np.int64), np.empty(m)
+    if m == 0:
+        return positions, time
+    lo = stp.min()
+    keys = np.empty(m, np.int64)
+    for k in range(m):
+        keys[k] = (stp[k] - lo) * n + order[idx[k]]
+    top, passes = keys.max(), 0
+    while top > 0:
+        top >>= 11
+        passes += 1
+    if passes > 3:
+        keys = keys[np.argsort(keys)]
+    else:
+        other, count = np.empty(m, np.int64), np.empty(2049, np.int64)
+        for p in range(passes):
+            shift = 11 * p
+            count[:] = 0
+            for k in range(m):
+                count[((keys[k] >> shift) & 2047) + 1] += 1
+            for d in range(1, 2049):
+                count[d] += count[d - 1]
+            for k in range(m):
+                d = (keys[k] >> shift) & 2047
+                other[count[d]] = keys[k]
+                count[d] += 1
+            keys, other = other, keys
+    for k in range(m):
+        step = keys[k] // n
+        positions[k] = keys[k] - step * n
+        time[k] = (step + lo + step0) * dt
+    return positions, time
 
 
 def _type_positions(population, afferent_types) -> np.ndarray:

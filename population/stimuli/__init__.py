@@ -11,6 +11,8 @@
   depth, stick and slip);
 - `indentation`: indentation stimuli (probes, bars, pin arrays; ramps, vibration, noise, taps) as
   scenes through the mechanics, and `indentation_spec` their settings tables (``ddmm simulate --indent``);
+- `transduction`: each type's front end from the stress at its receptor depth to its drive (gain and
+  lead-lag; fitted to TouchSim's responses);
 - `surfaces`: textured surfaces (gratings, dot patterns, embossed letters, bitmaps) scanned across the
   skin, as indentation scenes.
 """
@@ -28,6 +30,7 @@ _WHERE = {
     "indentation": ("Pins", "band_noise", "bar_pins", "circle_pins", "impulse", "indent", "pin_array", "probe",
                     "ramp_hold", "sinusoid"),
     "indentation_spec": ("indentation_from_dict",),
+    "transduction": ("TRANSDUCTIONS", "Transduction", "get_transduction"),
     "surfaces": ("Surface", "dot_pattern", "from_bitmap", "grating", "letters", "min_scan_fs", "scan"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

@@ -2,6 +2,8 @@
 
 - `contact_loads`: the per-sample contact solve, one factorisation per set of touching pins;
 - `rate`: time derivatives at a sample rate;
+- `bilinear`: a heightmap sampled at fractional pixels (scanned surfaces: 4.5 M points a second of a 6 mm
+  window at 5 kHz; numpy's gathers took 3 s, the loop takes a few ms);
 - `surface_wave`, `delayed_sum`: TouchSim's delayed surface wave.  Every (pin, point) pair has its own
   delay, so grouping pairs by delay and multiplying dense matrices does the work once per distinct delay
   (measured: 3.8 s for one pin and 12,584 points at 5 kHz); the numba loop does it once.
@@ -12,7 +14,31 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-__all__ = ["contact_loads", "delayed_sum", "rate", "surface_wave"]
+__all__ = ["bilinear", "contact_loads", "delayed_sum", "rate", "surface_wave"]
+
+
+@nb.njit(cache=True, nogil=True)
+def bilinear(h: np.ndarray, u: np.ndarray, v: np.ndarray, periodic: bool) -> np.ndarray:
+    """``h`` (n_rows, n_cols) at fractional (column ``u``, row ``v``), same-shaped 2-D ``u`` and ``v``: wrapped
+    when ``periodic``, 0 outside otherwise."""
+    n_rows, n_cols = h.shape
+    out = np.zeros(u.shape)
+    for i in range(u.shape[0]):
+        for j in range(u.shape[1]):
+            c0, r0 = np.floor(u[i, j]), np.floor(v[i, j])
+            fu, fv = u[i, j] - c0, v[i, j] - r0
+            total = 0.0
+            for dr in range(2):
+                wr = fv if dr else 1.0 - fv
+                for dc in range(2):
+                    wc = fu if dc else 1.0 - fu
+                    r, c = int(r0) + dr, int(c0) + dc
+                    if periodic:
+                        total += wr * wc * h[r % n_rows, c % n_cols]
+                    elif 0 <= r < n_rows and 0 <= c < n_cols:
+                        total += wr * wc * h[r, c]
+            out[i, j] = total
+    return out
 
 
 @nb.njit(cache=True, nogil=True)

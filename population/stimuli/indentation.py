@@ -45,6 +45,7 @@ from ddmm.population.stimuli.contact import (
     tangential_loads,
 )
 from ddmm.population.stimuli.scenes import REFERENCE_AREA_MM2, Scene, Sites
+from ddmm.population.stimuli.transduction import get_transduction
 from ddmm.utils.validation import as_finite_array, check_nonnegative, check_positive, check_real, shown
 
 __all__ = ["ContactSpread", "Pins", "bar_pins", "band_noise", "circle_pins", "impulse", "indent", "pin_array",
@@ -208,11 +209,38 @@ class ContactSpread:
         The pins' radius in mm (as the skin uses it).
     floor : float
         Relative floor of the coefficients (dimensionless).
+    transduction : tuple
+        ``(type code, Transduction)`` pairs (`ddmm.population.stimuli.transduction.get_transduction`):
+        each type's gain scales its coefficients, its lead-lag runs before its
+        own filters (`input_sections`); a type left out: unit gain, no filter.
     """
 
     skin: object
     radius_mm: float
     floor: float = 1e-6
+    transduction: tuple = ()
+
+    def input_sections(self, fs: float) -> dict:
+        """{type code: filter sections at ``fs`` Hz} of the types whose transduction filters (for
+        `ddmm.models.fused.FusedPipeline`'s ``input_sections``)."""
+        out = {kind: t.sections(fs) for kind, t in self.transduction}
+        return {kind: sos for kind, sos in out.items() if sos is not None}
+
+    def describe(self) -> dict:
+        """{name: value} of what shapes the spikes besides the loads, for a Dataset's per-condition record:
+        the skin's name and each type's transduction (gain, and zero and pole in Hz, NaN without a filter)."""
+        out = {"skin": self.skin.name}
+        for kind, t in self.transduction:
+            out.update({f"transduction_{kind}_gain": t.gain,
+                        f"transduction_{kind}_zero_hz": np.nan if t.zero_hz is None else t.zero_hz,
+                        f"transduction_{kind}_pole_hz": np.nan if t.pole_hz is None else t.pole_hz})
+        return out
+
+    def _gains(self, afferent_type) -> np.ndarray:
+        gains = np.ones(np.shape(afferent_type))
+        for kind, t in self.transduction:
+            gains[np.asarray(afferent_type) == kind] = t.gain
+        return gains
 
     def check_reach(self, population, sites) -> None:
         """Refuse a pin off the skin the population covers: farther from every afferent than
@@ -238,6 +266,7 @@ class ContactSpread:
         peak = stress_kernel(np.zeros(1), np.zeros(1), self.radius_mm, np.zeros(depth.size), np.zeros(depth.size),
                              depth)[0] * 1e-6
         w = np.where(k >= self.floor * peak[None, :], k * REFERENCE_AREA_MM2, 0.0).T  # (n_afferents, n_pins)
+        w *= self._gains(afferent_type)[:, None]
         rows, cols = np.nonzero(w)
         indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=w.shape[0]))]).astype(np.int64)
         return indptr, cols.astype(np.int64), w[rows, cols], np.any(w > 0.0, axis=1).astype(float)
@@ -384,7 +413,7 @@ def impulse(amplitude_mm: float, *, width_s: float = 0.01, pad_s: float = 0.045,
 
 
 def indent(pins: Pins, depth_mm, *, fs: float = INDENT_FS, lateral_mm=None, skin="default",
-           name: str = "indentation") -> Scene:
+           transduction="fitted", name: str = "indentation") -> Scene:
     """A scene of ``pins`` pressed into the skin by ``depth_mm``, through the skin's mechanics.
 
     Parameters
@@ -400,13 +429,18 @@ def indent(pins: Pins, depth_mm, *, fs: float = INDENT_FS, lateral_mm=None, skin
         the skin tangentially, with Coulomb stick and slip.
     skin : str or SkinMechanics
         ``"default"`` or ``"touchsim"`` (`ddmm.population.stimuli.contact.SKIN_MODELS`).
+    transduction : str or mapping
+        Each type's front end from stress to drive: ``"fitted"`` (default),
+        ``"none"`` (the mechanics straight into the force path) or a mapping
+        of type to `ddmm.population.stimuli.transduction.Transduction`.
     name : str
 
     Returns
     -------
     Scene
         A multi-site scene, one site per pin with its load (Q_x, Q_y, P) in N,
-        spread to the afferents by the mechanics (`ContactSpread`).
+        spread to the afferents by the mechanics and the transduction
+        (`ContactSpread`).
 
     Examples
     --------
@@ -426,7 +460,7 @@ def indent(pins: Pins, depth_mm, *, fs: float = INDENT_FS, lateral_mm=None, skin
     if lateral_mm is not None:
         forces[:, :, :2] = tangential_loads(_lateral(lateral_mm, depth.shape), loads, radius, skin)
     sites = Sites(pins.x_mm, pins.y_mm, radius, site_id=[f"pin{i}" for i in range(len(pins))],
-                  spread=ContactSpread(skin, radius))
+                  spread=ContactSpread(skin, radius, transduction=get_transduction(transduction)))
     return Scene.from_sites(forces, sites, fs=fs, name=name)
 
 

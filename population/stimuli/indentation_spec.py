@@ -17,7 +17,8 @@ file) names a waveform ``kind`` and its settings, the pins and the skin:
 - ``lateral_mm`` and ``lateral_deg``: the pins slide by ``lateral_mm`` along
   ``lateral_deg`` (0 radial, 90 distal) at a constant speed over the middle
   third of the stimulus, and stay there (default 0: no sideways motion);
-- ``skin``: ``default`` or ``touchsim``; ``name``: the condition's name.
+- ``skin``: ``default`` or ``touchsim``; ``transduction``: ``fitted`` (default) or ``none``
+  (`ddmm.population.stimuli.transduction`); ``name``: the condition's name.
 
 Every unknown key, kind or pin shape is refused with a `ValueError` naming it
 and what is allowed.
@@ -46,7 +47,7 @@ PIN_SHAPES = {
     "bar": ("width_mm", "height_mm", "angle_deg", "pins_per_mm", "x_mm", "y_mm"),
     "circle": ("disc_radius_mm", "curvature_mm", "pins_per_mm", "x_mm", "y_mm"),
 }
-_COMMON = ("kind", "fs", "pins", "lateral_mm", "lateral_deg", "skin", "name")
+_COMMON = ("kind", "fs", "pins", "lateral_mm", "lateral_deg", "skin", "transduction", "name")
 
 
 def indentation_from_dict(table: dict):
@@ -80,7 +81,8 @@ def indentation_from_dict(table: dict):
     pins = _pins(shape, table)
     lateral = _lateral_ramp(table, depth.size, len(pins))
     name = table.get("name", _default_name(kind, table))
-    return ind.indent(pins, depth, fs=fs, lateral_mm=lateral, skin=table.get("skin", "default"), name=str(name))
+    return ind.indent(pins, depth, fs=fs, lateral_mm=lateral, skin=table.get("skin", "default"),
+                      transduction=str(table.get("transduction", "fitted")), name=str(name))
 
 
 def _pins(shape: str, table: dict):

@@ -79,8 +79,10 @@ class Sites:
         How the sites' forces reach the afferents: None for the receptive
         fields (`ddmm.population.anatomy.receptive_fields.local_mixing`), or an object
         with that function's ``local_mixing(x_mm, y_mm, afferent_type,
-        sites)`` and ``check_reach(population, sites)``: an indentation's
-        skin mechanics (`ddmm.population.stimuli.indentation.ContactSpread`).
+        sites)`` and ``check_reach(population, sites)``, and optionally
+        ``input_sections(fs)`` (filter sections by type run before each
+        type's own): an indentation's skin mechanics and transduction
+        (`ddmm.population.stimuli.indentation.ContactSpread`).
     """
 
     x_mm: np.ndarray

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ddmm.population.stimuli._contact_kernels import bilinear
 from ddmm.population.stimuli.contact import SkinMechanics, get_skin_mechanics
 from ddmm.population.stimuli.indentation import MAX_DEPTH_MM, Pins, indent
 from ddmm.utils.resources import check_memory
@@ -175,24 +176,9 @@ class Surface:
         n_rows, n_cols = self.shape
         u = x / self.pixel_mm + (n_cols - 1) / 2.0  # fractional column
         v = y / self.pixel_mm + (n_rows - 1) / 2.0  # fractional row
-        return _bilinear(self.height_mm, u, v, self.periodic)
-
-
-def _bilinear(h: np.ndarray, u: np.ndarray, v: np.ndarray, periodic: bool) -> np.ndarray:
-    """``h`` at fractional (column u, row v): wrapped when periodic, 0 outside otherwise."""
-    c0, r0 = np.floor(u).astype(np.int64), np.floor(v).astype(np.int64)
-    fu, fv = u - c0, v - r0
-    out = np.zeros(u.shape)
-    for dr, wr in ((0, 1.0 - fv), (1, fv)):
-        for dc, wc in ((0, 1.0 - fu), (1, fu)):
-            r, c = r0 + dr, c0 + dc
-            if periodic:
-                value = h[r % h.shape[0], c % h.shape[1]]
-            else:
-                inside = (r >= 0) & (r < h.shape[0]) & (c >= 0) & (c < h.shape[1])
-                value = np.where(inside, h[np.clip(r, 0, h.shape[0] - 1), np.clip(c, 0, h.shape[1] - 1)], 0.0)
-            out += wr * wc * value
-    return out
+        shape = u.shape
+        u2, v2 = np.ascontiguousarray(u, dtype=float).reshape(1, -1), np.ascontiguousarray(v, dtype=float).reshape(1, -1)
+        return bilinear(np.ascontiguousarray(self.height_mm, dtype=float), u2, v2, bool(self.periodic)).reshape(shape)
 
 
 def _whole_pixels(value_mm: float, name: str, pixel_mm: float) -> int:
@@ -420,7 +406,7 @@ def _check_scan(surface, speed_mm_s, contact_mm, fs) -> tuple:
 
 def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0.0, duration_s: float = 1.0,
          contact_mm: float = 0.8, window_mm=(8.0, 8.0), pitch_mm: float = 0.2, friction: bool = True,
-         fs: float = 2000.0, skin="default", center_mm=(0.0, 0.0), name: str | None = None):
+         fs: float = 2000.0, skin="default", transduction="fitted", center_mm=(0.0, 0.0), name: str | None = None):
     """A scene of ``surface`` pressed into the skin and slid across it at constant velocity.
 
     The surface's centre passes under ``center_mm`` half-way through the
@@ -452,6 +438,8 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
         Sample rate in Hz, at least ``2 * speed_mm_s / surface.pixel_mm``
         (`min_scan_fs`: the surface moves at most half a pixel a sample).
     skin : str or SkinMechanics
+    transduction : str or mapping
+        Each type's front end from stress to drive (`indent`'s).
     center_mm : (float, float)
         Centre of the window in mm.
     name : str, optional
@@ -485,4 +473,4 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
     depth = np.maximum(contact - (surface.max_height_mm - h), 0.0)
     lateral = travel[:, None] * unit[None, :] if friction else None
     name = f"scan_{speed:g}mm_s_{np.rad2deg(angle):g}deg" if name is None else name
-    return indent(pins, depth, fs=fs, lateral_mm=lateral, skin=skin, name=name)
+    return indent(pins, depth, fs=fs, lateral_mm=lateral, skin=skin, transduction=transduction, name=name)

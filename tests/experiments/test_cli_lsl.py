@@ -17,7 +17,7 @@ import pytest
 
 from ddmm.population import birznieks, sample_population
 from ddmm.population.runtime.lsl import open_force_outlet
-from ddmm.population.runtime.lsl_outlets import read_spike_metadata
+from ddmm.population.runtime.lsl_outlets import decode_spikes, read_spike_metadata
 from ddmm.population.runtime.stream import Encoder
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "live-sensors.md"
@@ -43,8 +43,10 @@ def _inlet(name, timeout):
     return inlet, info
 
 
-def test_stream_over_lsl_equals_the_in_process_encoder():
-    """A force outlet here, ``ddmm stream --lsl-in --lsl-out`` in another process, the spikes read back here."""
+@pytest.mark.parametrize("spike_format", ["events", "batched"])
+def test_stream_over_lsl_equals_the_in_process_encoder(spike_format):
+    """A force outlet here, ``ddmm stream --lsl-in --lsl-out`` in another process, the spikes read back here
+    and decoded (`decode_spikes`) as the stream's meta-data say."""
     import pylsl
 
     force, spikes = _name("force"), _name("spikes")
@@ -52,9 +54,14 @@ def test_stream_over_lsl_equals_the_in_process_encoder():
     raw = np.column_stack([scene.fx, scene.fy, scene.fz])[::2] * 1e3  # 500 Hz, in mN
     outlet = open_force_outlet(force, fs=500.0, units="mN")
     proc = _ddmm("stream", "--lsl-in", force, "--lsl-out", spikes, "--seed", "3", "--types", "SAI,RAI,SAII",
-                 "--duration", f"{raw.shape[0] / 500.0}", "--resolve-timeout", "60")
+                 "--duration", f"{raw.shape[0] / 500.0}", "--resolve-timeout", "60", "--lsl-spike-format",
+                 spike_format)
     try:
         inlet, info = _inlet(spikes, 90.0)  # the first run in a fresh environment compiles numba kernels
+        meta = read_spike_metadata(info)
+        deadline = time.monotonic() + 60.0
+        while not outlet.have_consumers() and time.monotonic() < deadline:  # the bridge opens its inlet after
+            time.sleep(0.01)  # its spike stream appears: LSL drops what is pushed before it subscribes
         t0 = pylsl.local_clock()
         for a in range(0, raw.shape[0], 7):
             outlet.push_chunk(raw[a:a + 7], (t0 + np.arange(a, min(a + 7, raw.shape[0])) / 500.0).tolist())
@@ -62,17 +69,19 @@ def test_stream_over_lsl_equals_the_in_process_encoder():
         ids, stamps, chunk_len = [], [], 1
         deadline = time.monotonic() + 60.0
         while time.monotonic() < deadline and (proc.poll() is None or len(ids) == 0 or chunk_len):
-            samples, ts = inlet.pull_chunk(timeout=0.2, max_samples=4096, min_samples=1, as_numpy=True)
+            samples, ts = inlet.pull_chunk(timeout=0.2, max_samples=max(64, 4096 // info.channel_count()),
+                                           min_samples=1, as_numpy=True)
             chunk_len = len(ts)
             if chunk_len:
-                ids.append(samples[:, 0].astype(np.int64))
-                stamps.append(np.asarray(ts))
+                got_ids, got_stamps = decode_spikes(samples, ts, meta["format"])
+                ids.append(got_ids)
+                stamps.append(got_stamps)
         out, err = proc.communicate(timeout=30)
     finally:
         proc.kill()
     assert proc.returncode == 0, err
     assert f"{raw.shape[0]:,} samples in" in err and "(duration)" in err
-    meta = read_spike_metadata(info)
+    assert meta["format"] == spike_format and f"{spike_format} format" in err
     offset = float(meta["input"]["clock_offset_s"])
     pop = sample_population("fingertip", rng=3)
     expected = Encoder(pop, 500.0, seed=3, afferent_types=("SAI", "RAI", "SAII")).push(raw * 1e-3)

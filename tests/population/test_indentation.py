@@ -158,7 +158,7 @@ def test_the_spread_is_the_stress_at_each_types_depth_times_the_reference_area()
     from ddmm.population.anatomy.receptive_fields import REFERENCE_AREA_MM2, local_mixing
     from ddmm.population.stimuli.contact import get_skin_mechanics
 
-    scene = indent(probe(radius_mm=0.5), ramp_hold(0.3, fs=FS, hold_s=0.05), fs=FS)
+    scene = indent(probe(radius_mm=0.5), ramp_hold(0.3, fs=FS, hold_s=0.05), fs=FS, transduction="none")
     types = np.array(["SAI", "RAII", "SAI"])
     indptr, sites, coeff, cover = local_mixing([0.0, 0.0, 3.0], [0.0, 0.0, 0.0], types, scene.sites)
     a, skin = 0.5, get_skin_mechanics("default")

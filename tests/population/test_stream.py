@@ -207,3 +207,78 @@ def test_stdout_times_are_on_the_input_clock_in_both_modes(capsys, monkeypatch):
     assert out.getvalue() == from_stdin
     times = np.array([float(r.split(",")[0]) for r in from_stdin.splitlines()])
     assert times.min() > 5.0 and (times > 5.45).any() and not ((times > 5.4) & (times < 5.45)).any()
+
+
+def test_a_chunk_refused_after_it_ran_loses_an_euler_encoder_until_reset():
+    """Euler's pushes write the state in place: a chunk refused once it ran (here a SpikeCapWarning made an
+    error) leaves no usable state, so every later push says so until `reset`; after it, the spikes are a
+    fresh encoder's."""
+    import warnings
+
+    from ddmm.models.engines import SpikeCapWarning
+    from ddmm.population import birznieks, make_population
+
+    pop, scene = make_population(["SAI"] * 3, gain=1e4), birznieks(90.0)
+    forces = np.column_stack([scene.fx, scene.fy, scene.fz])
+    enc = Encoder(pop, scene.fs, seed=0, conditioning=None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SpikeCapWarning)
+        with pytest.raises(SpikeCapWarning):
+            enc.push(forces[:200])
+    with pytest.raises(ValueError, match=r"changed the encoder's state \(SpikeCapWarning.*reset\(\) first"):
+        enc.push(forces[200:201])
+    enc.reset()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SpikeCapWarning)
+        got, want = enc.push(forces[:300]), Encoder(pop, scene.fs, seed=0, conditioning=None).push(forces[:300])
+    assert got.afferent.size > 10
+    np.testing.assert_array_equal(got.afferent, want.afferent)
+    np.testing.assert_array_equal(got.time, want.time)
+
+
+@pytest.mark.parametrize("method", ["rk4", "rk2"])
+def test_a_chunk_an_explicit_method_refuses_leaves_the_state_untouched(method):
+    """The explicit methods' stability check refuses a chunk after it ran; their pushes write spare buffers,
+    so the encoder goes on as if the chunk had never come (the same spikes as one that never saw it)."""
+    from ddmm.models.currents import CurrentParams
+    from ddmm.models.engines import NumericalInstabilityError
+    from ddmm.population import make_population
+
+    # SA-II stretched against its preferred direction: -30 mV/ms, refused at dt = 2 ms (as offline).
+    pop = make_population(["SAII"] * 4, theta_t=0.0, nap="selective",
+                          current=CurrentParams().with_type("SAII", opponent=1.0, gain=10.0))
+    good = np.column_stack([np.linspace(0.0, 2.0, 400), np.zeros(400), np.full(400, 1.0)])  # stretch: it fires
+    bad = np.column_stack([np.full(30, -5.0), np.zeros(30), np.full(30, 1.0)])
+    enc, ref = (Encoder(pop, 500.0, dt=2e-3, method=method, seed=0, conditioning=None) for _ in range(2))
+    outs = [enc.push(good[:150])]
+    with pytest.raises(NumericalInstabilityError, match="unstable"):
+        enc.push(bad)
+    assert enc.n_samples == 150
+    outs.append(enc.push(good[150:]))
+    want = ref.push(good)
+    assert want.afferent.size > 10
+    np.testing.assert_array_equal(np.concatenate([o.afferent for o in outs]), want.afferent)
+    np.testing.assert_array_equal(np.concatenate([o.time for o in outs]), want.time)
+
+
+@pytest.mark.parametrize("threads", ["1", "2"])
+def test_pushes_keep_the_profile_of_a_held_shear_direction_and_turn_with_it(monkeypatch, threads):
+    """Each push range keeps its profile AF while the shear direction holds, from push to push: turning,
+    holding and reversing the shear, one sample a push, gives the offline spikes, on one range or two."""
+    from ddmm.models.engines import get_engine
+
+    monkeypatch.setattr(get_engine("direct"), "parallel_min_afferents", 1)
+    monkeypatch.setenv("DDMM_NUM_THREADS", threads)
+    pop = sample_population("fingertip", rng=0)
+    n = 600
+    angle = np.r_[np.full(200, 0.3), np.linspace(0.3, 2.0, 200), np.full(200, 2.0 + np.pi)]
+    mag = np.interp(np.arange(n), [0, 50, 600], [0.0, 0.6, 0.6])
+    scene = Scene(mag * np.cos(angle), mag * np.sin(angle), np.interp(np.arange(n), [0, 50, 600], [0, 2, 2]),
+                  1000.0, "turn")
+    offline = simulate(pop, scene, engine="direct", seed=4, quiet=True)
+    forces = np.column_stack([scene.fx, scene.fy, scene.fz])
+    enc = Encoder(pop, 1000.0, seed=4, conditioning=None)
+    aff, t = concat([enc.push(forces[k:k + 1]) for k in range(n)])
+    assert aff.size > 100
+    np.testing.assert_array_equal(aff, offline.spike_afferent.values)
+    np.testing.assert_array_equal(t, offline.spike_time.values)
