@@ -58,11 +58,11 @@ def _transduction(x) -> object:
 def named_rates(kind: str, transduction, seed: int = 0) -> dict:
     """{stimulus: mean rate (spikes/s)} of the named list's ``kind`` units under ``transduction`` (a
     `Transduction`), on the default skin."""
-    from ddmm.experiments.validation.touchsim_side_by_side import _units, named_list
+    from ddmm.experiments.validation.touchsim_side_by_side import named_list, named_units
     from ddmm.population import simulate
     from ddmm.population.stimuli.indentation import indent, probe
 
-    units = _units()
+    units = named_units()
     units = units.select(np.flatnonzero(units.afferent_type == kind))
     out = {}
     for name, (depth, _) in named_list().items():

@@ -25,7 +25,7 @@ import json
 
 import numpy as np
 
-__all__ = ["PAIRS", "ddmm_responses", "grating_scene", "main", "named_list", "touchsim_summary"]
+__all__ = ["PAIRS", "ddmm_responses", "grating_scene", "main", "named_list", "named_units", "touchsim_summary"]
 
 #: ddmm's type for each TouchSim class (TouchSim fits SA1, RA and PC only).
 PAIRS = {"SA1": "SAI", "RA": "RAI", "PC": "RAII"}
@@ -61,7 +61,7 @@ def _nearest(pop) -> np.ndarray:
                            for t, n in _UNITS.items()])
 
 
-def _units():
+def named_units():
     """The fingertip preset's units nearest its centre, ``_UNITS`` of each type, moved to (0, 0)."""
     from ddmm.population import sample_population
 
@@ -86,7 +86,7 @@ def ddmm_responses(seed: int = 0) -> dict:
     from ddmm.population import simulate
     from ddmm.population.stimuli.indentation import indent, probe
 
-    units, out = _units(), {}
+    units, out = named_units(), {}
     for name, (depth, _) in named_list().items():
         ds = simulate(units, indent(probe(), depth, fs=5000.0, name=name), engine="direct", seed=seed, quiet=True)
         out[name] = _summary(ds, depth.size / 5000.0)

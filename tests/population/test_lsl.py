@@ -6,60 +6,31 @@ every stream name is unique to its test, every wait is bounded.
 
 import threading
 import time
-import uuid
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ddmm.population import from_csv, sample_population, simulate
 from ddmm.population.runtime.lsl import ChunkReader, ForceStream, open_force_outlet, open_force_stream
 from ddmm.population.runtime.lsl_outlets import SpikeOutlet, read_spike_metadata
 from ddmm.population.runtime.lsl_bridge import Bridge, check_stamps
 from ddmm.population.runtime.stream import Encoder
 
-FS, DT = 500.0, 1e-4
-
-
-def _name(what):
-    return f"ddmm-test-{what}-{uuid.uuid4().hex[:8]}"
+from .lsl_support import DT, FS, Collect, plate_recording
+from .lsl_support import unique_name as _name
 
 
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory):
-    """A noisy 500 Hz force-plate recording in mN (press, push, hold) and its offline run from the file."""
-    rng = np.random.default_rng(11)
-    n = 900
-    t = np.arange(n) / FS
-    f = np.column_stack([np.interp(t, [0, 0.6, 1.0], [0, 0, 0.8]), np.interp(t, [0, 0.6, 1.2], [0, 0, -0.5]),
-                         np.interp(t, [0, 0.1, 0.5, 2], [0, 0, 2.5, 2.5])]) + rng.normal(0, 0.01, (n, 3))
-    path = tmp_path_factory.mktemp("plate") / "plate.csv"
-    path.write_text("time,fx,fy,fz\n" + "".join(f"{a!r},{b!r},{c!r},{d!r}\n" for a, (b, c, d) in zip(t.tolist(), (f * 1e3).tolist())))
-    pop = sample_population("fingertip", rng=0).select(np.arange(0, 991, 5))
-    with pytest.warns(UserWarning, match="FA-II's band"):
-        scene = from_csv(path, units="mN")
-    offline = simulate(pop, scene, engine="direct", seed=4, quiet=True)
-    ids = offline.afferent.values[offline.spike_afferent.values]
-    steps = np.round(offline.spike_time.values / DT).astype(np.int64)
-    return pop, f * 1e3, ids, steps
+    return plate_recording(tmp_path_factory)
 
 
 def _fake(offset=0.25, n_sites=1):
     return ForceStream("fake", "fake-id", "host", FS, n_sites, "mN", 1, offset, inlet=None)
 
 
-class _Collect:
-    def __init__(self):
-        self.positions, self.stamps = [], []
-
-    def __call__(self, positions, stamps):
-        self.positions.append(np.asarray(positions))
-        self.stamps.append(np.asarray(stamps))
-
-    def arrays(self):
-        return (np.concatenate(self.positions or [np.empty(0, int)]),
-                np.concatenate(self.stamps or [np.empty(0)]))
+_Collect = Collect
 
 
 def test_check_stamps_keeps_increasing_stamps_and_measures_gaps():

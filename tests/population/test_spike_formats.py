@@ -7,7 +7,6 @@ import subprocess
 import sys
 import threading
 import time
-import uuid
 from itertools import pairwise
 
 import numpy as np
@@ -15,18 +14,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ddmm.population import from_csv, sample_population, simulate
 from ddmm.population.runtime.lsl import open_force_outlet, open_force_stream
 from ddmm.population.runtime.lsl_bridge import Bridge
 from ddmm.population.runtime.lsl_outlets import SpikeOutlet, read_spike_metadata
 from ddmm.population.runtime.spike_formats import FRAME_CAPACITY, SPIKE_FORMATS, _frames, _jit, decode_spikes
 from ddmm.population.runtime.stream import Encoder
 
-FS, DT = 500.0, 1e-4
-
-
-def _name(what):
-    return f"ddmm-test-{what}-{uuid.uuid4().hex[:8]}"
+from .lsl_support import DT, FS, plate_recording
+from .lsl_support import unique_name as _name
 
 
 def _bits(x):
@@ -98,22 +93,7 @@ def test_frames_of_any_capacity_decode_to_the_spikes_bit_for_bit(groups, capacit
 
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory):
-    """A noisy 500 Hz force-plate recording in mN and its offline run from the file (as test_lsl.py's)."""
-    rng = np.random.default_rng(11)
-    n = 900
-    t = np.arange(n) / FS
-    f = np.column_stack([np.interp(t, [0, 0.6, 1.0], [0, 0, 0.8]), np.interp(t, [0, 0.6, 1.2], [0, 0, -0.5]),
-                         np.interp(t, [0, 0.1, 0.5, 2], [0, 0, 2.5, 2.5])]) + rng.normal(0, 0.01, (n, 3))
-    path = tmp_path_factory.mktemp("plate") / "plate.csv"
-    path.write_text("time,fx,fy,fz\n" + "".join(f"{a!r},{b!r},{c!r},{d!r}\n"
-                                                for a, (b, c, d) in zip(t.tolist(), (f * 1e3).tolist())))
-    pop = sample_population("fingertip", rng=0).select(np.arange(0, 991, 5))
-    with pytest.warns(UserWarning, match="FA-II's band"):
-        scene = from_csv(path, units="mN")
-    offline = simulate(pop, scene, engine="direct", seed=4, quiet=True)
-    ids = offline.afferent.values[offline.spike_afferent.values]
-    steps = np.round(offline.spike_time.values / DT).astype(np.int64)
-    return pop, f * 1e3, ids, steps
+    return plate_recording(tmp_path_factory)
 
 
 def _spike_inlet(name):

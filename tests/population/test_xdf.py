@@ -18,21 +18,13 @@ from ddmm.population.runtime.stream import Encoder
 from ddmm.population.stimuli.scenes import Sites
 from ddmm.utils.extras import MissingExtraError
 
-FS = 500.0
+from .lsl_support import FS, Collect
+
 # 500 Hz streams, as in tests/population/test_lsl.py: FA-II's band is missing, and said so once per read
 pytestmark = pytest.mark.filterwarnings("ignore::ddmm.population.stimuli.recordings.RecordingBandWarning")
 
 
-class _Collect:
-    def __init__(self):
-        self.positions, self.stamps = [], []
-
-    def __call__(self, positions, stamps):
-        self.positions.append(np.asarray(positions))
-        self.stamps.append(np.asarray(stamps))
-
-    def arrays(self):
-        return np.concatenate(self.positions), np.concatenate(self.stamps)
+_Collect = Collect
 
 
 @pytest.fixture(scope="module")
