@@ -71,10 +71,13 @@ import numpy as np
 from ddmm.population.stimuli._conditioning_kernels import (
     GateSettings,
     GateState,
+    StreamSettings,
+    StreamState,
     gate_hold_contact,
     hold_band,
     hold_counts,
     noise_scale,
+    push_steady,
     smooth_band,
     sos_filter,
     track_band,
@@ -241,6 +244,7 @@ class Conditioner:
         if conditioning.mode != "causal":
             raise ValueError("a Conditioner (a stream) is causal; mode='zero_phase' exists offline only")
         self.settings, self.n_sites = conditioning, None if n_sites is None else check_count(n_sites, "n_sites")
+        self._want = (3,) if self.n_sites is None else (self.n_sites, 3)  # a chunk's shape but its length
         self.fs_in, self.fs_out = check_positive(fs_in, "fs_in", "Hz"), check_positive(fs_out, "fs_out", "Hz")
         cutoff = min(0.45 * self.fs_in, 0.45 * self.fs_out, conditioning.bandwidth_hz or math.inf)
         self._up = self.fs_out >= self.fs_in
@@ -254,6 +258,7 @@ class Conditioner:
         self._slow_state = self._smooth_state = None  # `track_band`'s and `smooth_band`'s, from the first chunk
         self._contact = self._held = self._track = None
         self._noise = None  # `track_noise`'s state, from the first chunk
+        self._steady = None  # `push_steady`'s (settings, state), once the states have started
         self._noise_rates = _noise_rates(self.fs_in)
         self._scale_gamma = 1.0 - math.exp(-1.0 / (_SCALE_SMOOTH_S * self.fs_out))
         self._moves = _hold_moves(conditioning, self.fs_out)
@@ -282,9 +287,8 @@ class Conditioner:
 
     def _shape(self, forces):
         forces = as_finite_array(forces, "forces")
-        want = (3,) if self.n_sites is None else (self.n_sites, 3)
-        if forces.ndim != len(want) + 1 or forces.shape[1:] != want:
-            raise ValueError(f"forces must have shape (n, {', '.join(map(str, want))}), got {forces.shape}")
+        if forces.ndim != len(self._want) + 1 or forces.shape[1:] != self._want:
+            raise ValueError(f"forces must have shape (n, {', '.join(map(str, self._want))}), got {forces.shape}")
         return forces.reshape(forces.shape[0], -1)
 
     def _picks(self, n: int) -> np.ndarray:
@@ -338,6 +342,13 @@ class Conditioner:
         contact : ndarray of bool, shape (m,) or (m, n_sites)
             The contact state per output sample.
         """
+        steady = self._steady or self._start_steady()
+        if steady and type(forces) is np.ndarray and forces.shape[1:] == self._want and forces.shape[0] \
+                and forces.dtype == np.float64 and forces.flags.c_contiguous:  # a live push: one kernel call
+            finite, y, contact = push_steady(forces, self._k, self.widths, *steady)
+            if finite:  # else `_shape` raises
+                self._k += forces.shape[0]
+                return self._out(y, contact)
         x = self._shape(forces)
         sites = x.shape[1] // 3
         if x.shape[0] == 0:
@@ -355,6 +366,23 @@ class Conditioner:
         else:
             slow, kept, gate = y, y, -1.0
         return self._out(*self._finish(y, slow, kept, gate, widths, scale))
+
+    def _start_steady(self):
+        """`push_steady`'s settings and state (the general path's, shared), once that path has started them."""
+        if not self._up or self._held is None:
+            return None
+        s, unused = self.settings, np.zeros((7, self._held.size))  # `unused`: states the settings never read
+        gate = (_GATE * s.noise_n if s.noise_n > 0 else -1.0, self.widths, self._moves, s.contact_on_n,
+                s.contact_off_n, s.shear_deadband_n)  # a GateSettings's fields
+        settings = StreamSettings(self._sos_rate, self.fs_out / self.fs_in, s.noise_n, s.adapt_noise and s.noise_n > 0,
+                                  self._noise_rates, self._scale_gamma, (s.slow_hz, _SMOOTH * s.slow_hz, 0.45 *
+                                  self.fs_out, self.fs_out), np.stack([_NORMAL_ONLY, _SHEAR_ONLY]), gate)
+        state = StreamState(self._zi_rate, unused if self._noise is None else self._noise,
+                            unused[:2] if self._slow_state is None else self._slow_state,
+                            unused[:2] if self._smooth_state is None else self._smooth_state,
+                            (self._held, self._track, self._contact, self._taken))  # a GateState's fields
+        self._steady = tuple(settings), tuple(state)  # plain tuples: numba types them ~3x faster than named ones
+        return self._steady
 
     def _bands(self, y, scale, normal):
         """The tracker's slow band and the kept band (the normal hold, then the smoothing), both as wide as

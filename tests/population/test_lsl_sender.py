@@ -56,6 +56,7 @@ def _press(n, start=0):
 def _bridge(script, messages):
     force = ForceStream("glove", "glove-id", "host", FS, 1, "N", 1, 0.0, _Inlet(script))
     encoder = Encoder(make_population(["SAI", "RAI"], theta_t=[0.0, 90.0]), FS, seed=1)
+    encoder.warm_up()  # as `ddmm stream` does: a first push loading the kernels would eat the silences' margins
     spikes = []
     return Bridge(encoder, force, lambda p, t: spikes.append(t), report=messages.append), spikes
 
