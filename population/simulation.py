@@ -37,6 +37,8 @@ __all__ = ["SimConfig", "ChunkJob", "run_chunk", "simulate", "plan_run", "popula
            "chunk_forces", "default_chunk_size"]
 
 _PIPELINE = 2  # afferent blocks in flight at once
+#: The integration step `simulate` takes when given none, s (a scene's sample interval must be a whole number of it).
+DEFAULT_DT = 1e-4
 
 
 def default_chunk_size(engine, scheduler=None) -> int:
@@ -70,7 +72,7 @@ class SimConfig:
     """
 
     engine: str = "brian2"
-    dt: float = 1e-4
+    dt: float = DEFAULT_DT
     method: str = "euler"
     no_shear: str = "smooth"
     seed: int = 0
@@ -481,7 +483,7 @@ def _run_jobs(jobs, config, scheduler, progress) -> list:
 def _resolve_step(dt, method, tolerance, scenes):
     """(dt, method, attrs) from explicit values, a tolerance, or the defaults."""
     if tolerance is None:
-        return (1e-4 if dt is None else dt), ("euler" if method is None else method), {"tolerance": "none"}
+        return (DEFAULT_DT if dt is None else dt), ("euler" if method is None else method), {"tolerance": "none"}
     if dt is not None or method is not None:
         raise ValueError("give tolerance or dt/method, not both: tolerance chooses dt and method")
     if not scenes or not isinstance(scenes[0], Scene):

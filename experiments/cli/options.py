@@ -6,6 +6,7 @@ a registered engine appears in every ``--engine`` option without an edit here.
 
 from __future__ import annotations
 
+import argparse
 import math
 import re
 from pathlib import Path
@@ -14,6 +15,7 @@ from ddmm.experiments.cli.recording_options import (
     RECORDINGS,
     add_recording_options,
     conditioning_from_args,
+    given_recording_options,
     recorded_scene,
     refuse_csv_options,
 )
@@ -39,9 +41,9 @@ def add_engine_option(p, default: str) -> None:
 def add_run_options(p, *, out_required: bool) -> None:
     """The options of ``ddmm simulate`` and ``ddmm plan``: population, scene, engine, step, trials, output."""
     p.add_argument("--population", default="fingertip", help="fingertip, hand or a spec .toml file")
-    p.add_argument("--scene", default="birznieks",
-                   help=f"{', '.join(SCENES)}, a force .csv file, an .xdf session (LabRecorder; with --stream), "
-                        f"or a sensor-array file ({', '.join(EXTENSIONS)}; a long .csv with --sites)")
+    p.add_argument("--scene", default=None,
+                   help=f"{', '.join(SCENES)} (default birznieks), a force .csv file, an .xdf session (LabRecorder; "
+                        f"with --stream), or a sensor-array file ({', '.join(EXTENSIONS)}; a long .csv with --sites)")
     p.add_argument("--sites", default=None, metavar="SITES.csv",
                    help="sites table (site,x_mm,y_mm[,region][,radius_mm]): --scene is then a long CSV "
                         "of time,site,fx,fy,fz; with an .xdf --scene, the sites of its stream's channels "
@@ -147,8 +149,12 @@ def _indent_scene(args):
     for flag, value in (("--sites", args.sites), ("--theta-r", args.theta_r), ("--contact", args.contact)):
         if value is not None:
             raise ValueError(f"{flag} does not apply to an --indent stimulus: its pins and the skin give the forces")
-    if args.scene != "birznieks":
+    if args.scene is not None:
         raise ValueError(f"give either --indent or --scene, not both (--scene {args.scene!r})")
+    given = given_recording_options(args)
+    if given:
+        raise ValueError(f"{given[0]} reads a recorded --scene and does not apply to an --indent stimulus"
+                         + (": set its rate as --indent ...,fs=HZ" if given[0] == "--fs" else ""))
     if args.indent.lower().endswith(".toml"):
         try:
             with open(args.indent, "rb") as f:
@@ -165,11 +171,13 @@ def _indent_scene(args):
 def scenes_from_args(args) -> list:
     """The scenes named by ``--scene``, ``--sites``, ``--theta-r`` and ``--contact``."""
     from ddmm.population import birznieks, press_push_lift, rotating_shear
-    found = RECORDINGS.get(Path(args.scene).suffix.lower())
-    if getattr(args, "stream", None) is not None and (args.indent is not None or not (found and found.streams)):
-        raise ValueError(f"--stream picks a stream of an .xdf --scene, not of {args.scene!r}")
     if args.indent is not None:
         return [_indent_scene(args)]
+    if args.scene is None:  # the default scene; None told it apart from a --scene given beside --indent
+        args = argparse.Namespace(**{**vars(args), "scene": "birznieks"})
+    found = RECORDINGS.get(Path(args.scene).suffix.lower())
+    if getattr(args, "stream", None) is not None and not (found and found.streams):
+        raise ValueError(f"--stream picks a stream of an .xdf --scene, not of {args.scene!r}")
     array = _array_scene(args)
     if array is not None:
         return [array]

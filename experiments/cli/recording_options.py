@@ -11,7 +11,7 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 __all__ = ["RECORDINGS", "RecordedFormat", "add_recording_options", "conditioning_from_args", "csv_scene",
-           "recorded_scene", "refuse_csv_options", "sites_option", "xdf_scene"]
+           "given_recording_options", "recorded_scene", "refuse_csv_options", "sites_option", "xdf_scene"]
 
 _FIELDS = ("time", "fx", "fy", "fz")
 # the single-site CSV reader's options and their defaults (a sensor-array file states its own)
@@ -84,6 +84,17 @@ def conditioning_from_args(args):
         return None
     settings = {field: getattr(args, name) for field, name in _CONDITIONING.items() if getattr(args, name) is not None}
     return Conditioning(mode=args.conditioning, **settings)
+
+
+def given_recording_options(args) -> list:
+    """The recording options (`add_recording_options`) given away from their defaults, as the command line spells
+    them (``--fs``, ``--fixed-noise``, ...)."""
+    from ddmm.population.stimuli.file_options import MAX_FORCE_N
+
+    defaults = {**_CSV_ONLY, **dict.fromkeys(_CONDITIONING.values()), "stream": None, "max_force": MAX_FORCE_N,
+                "conditioning": "causal"}
+    flags = {name: "--fixed-noise" if name == "adapt_noise" else f"--{name.replace('_', '-')}" for name in defaults}
+    return [flags[name] for name, default in defaults.items() if getattr(args, name, default) != default]
 
 
 def refuse_csv_options(args, scene: str) -> None:

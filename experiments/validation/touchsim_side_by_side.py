@@ -2,10 +2,11 @@
 
 The named list (issue 43): a ramp-and-hold on one 1 mm probe at 0.25, 0.5 and 1.0 mm; sinusoids on the
 probe at 5-300 Hz and 0.01, 0.05 and 0.2 mm on a 0.3 mm pre-indentation; a 1 mm grating scanned at 40 mm/s
-(`grating_scene`).  ddmm's units are the fingertip preset's nearest units
-of each type, moved to the probe's centre (their own gains, sensitivities and noise), on the default skin;
-TouchSim's are its single models at the same place; ddmm reads the stress through its shipped transduction
-(``"fitted"``: fitted on half of these cells, `ddmm.experiments.calibration.displacement`).  TouchSim's figures come from its own run
+(`grating_scene`).  ddmm's units are the nearest units of each type of five fingertips (the preset sampled
+with five seeds: by default `HELD_OUT_SEEDS`, which the transduction fit never saw), moved to the probe's
+centre (their own gains, sensitivities and noise), on the default skin; TouchSim's are its single models at
+the same place; ddmm reads the stress through its shipped transduction (``"fitted"``: fitted on half of
+these cells with the units of `FIT_SEEDS`, `ddmm.experiments.calibration.displacement`).  TouchSim's figures come from its own run
 (`experiments/validation/touchsim_responses.py`, in TouchSim's environment), recorded in a JSON file.
 
 Run::
@@ -14,7 +15,8 @@ Run::
 
 It prints, per stimulus and type, both mean rates (spikes/s), their ratio and both median first-spike times.
 Cells of the transduction fit are FITTED, the rest (and the grating) HELD OUT
-(`ddmm.experiments.calibration.displacement.is_fitted_cell`).
+(`ddmm.experiments.calibration.displacement.is_fitted_cell`); on the held-out fingertips every cell is a
+prediction for units the fit never saw.
 """
 
 from __future__ import annotations
@@ -25,11 +27,15 @@ import json
 
 import numpy as np
 
-__all__ = ["PAIRS", "ddmm_responses", "grating_scene", "main", "named_list", "named_units", "touchsim_summary"]
+__all__ = ["FIT_SEEDS", "HELD_OUT_SEEDS", "PAIRS", "ddmm_responses", "grating_scene", "main", "named_list", "named_units", "touchsim_summary"]
 
 #: ddmm's type for each TouchSim class (TouchSim fits SA1, RA and PC only).
 PAIRS = {"SA1": "SAI", "RA": "RAI", "PC": "RAII"}
 _UNITS = {"SAI": 4, "RAI": 9, "RAII": 4}  # as many as TouchSim has single models of each class
+#: Fingertip seeds whose units the transduction fit saw (`ddmm.experiments.calibration.displacement`), and the
+#: seeds held out from it, on which this script compares by default.
+FIT_SEEDS = tuple(range(10))
+HELD_OUT_SEEDS = tuple(range(10, 20))
 
 
 def named_list() -> dict:
@@ -61,13 +67,22 @@ def _nearest(pop) -> np.ndarray:
                            for t, n in _UNITS.items()])
 
 
-def named_units():
-    """The fingertip preset's units nearest its centre, ``_UNITS`` of each type, moved to (0, 0)."""
+def named_units(seeds=(0,)):
+    """The nearest ``_UNITS`` units of each type of the fingertip preset sampled with each of ``seeds`` (its
+    ``rng``), all moved to (0, 0): ``_UNITS`` x ``len(seeds)`` of each type, each with its own sensitivity,
+    gain and noise.  A unit of seed s keeps its id plus s x 10**6, so units of different seeds never share an
+    id (nor the noise and excitability drawn from it)."""
     from ddmm.population import sample_population
 
-    pop = sample_population("fingertip", rng=0)
-    sub = pop.select(_nearest(pop))
-    return dataclasses.replace(sub, x_mm=np.zeros(len(sub)), y_mm=np.zeros(len(sub)))
+    parts = []
+    for seed in seeds:
+        pop = sample_population("fingertip", rng=seed)
+        sub = pop.select(_nearest(pop))
+        parts.append(dataclasses.replace(sub, afferent_id=sub.afferent_id + int(seed) * 10**6))
+    arrays = {f.name: np.concatenate([getattr(part, f.name) for part in parts])
+              for f in dataclasses.fields(parts[0]) if isinstance(getattr(parts[0], f.name), np.ndarray)}
+    arrays["x_mm"], arrays["y_mm"] = np.zeros(arrays["x_mm"].size), np.zeros(arrays["y_mm"].size)
+    return dataclasses.replace(parts[0], **arrays)
 
 
 def grating_scene():
@@ -80,21 +95,31 @@ def grating_scene():
                 window_mm=(6.0, 6.0), pitch_mm=0.2, fs=5000.0, name="grating_40mm_s")
 
 
-def ddmm_responses(seed: int = 0) -> dict:
+def ddmm_responses(seed: int = 0, seeds=HELD_OUT_SEEDS) -> dict:
     """{stimulus: {type: {"rate": mean spikes/s, "first_spike_s": median first-spike time or None, "vs": median
-    vector strength at 40 Hz after 0.1 s (the grating)}}}."""
-    from ddmm.population import simulate
+    vector strength at 40 Hz after 0.1 s (the grating)}}} of the `named_units` of the fingertip ``seeds``
+    (noise seed ``seed``).  The grating's per type: the mean over the seeds' rates, the median of their
+    medians."""
+    from ddmm.population import sample_population, simulate
     from ddmm.population.stimuli.indentation import indent, probe
 
-    units, out = named_units(), {}
+    units, out = named_units(seeds), {}
     for name, (depth, _) in named_list().items():
         ds = simulate(units, indent(probe(), depth, fs=5000.0, name=name), engine="direct", seed=seed, quiet=True)
         out[name] = _summary(ds, depth.size / 5000.0)
-    from ddmm.population import sample_population
-
     # The grating's window needs skin under every pin, so its units stay where they are in the fingertip.
-    out["grating_40mm_s"] = _grating_summary(sample_population("fingertip", rng=0), seed)
+    by_seed = [_grating_summary(sample_population("fingertip", rng=s), seed) for s in seeds]
+    out["grating_40mm_s"] = {kind: _pooled([g[kind] for g in by_seed]) for kind in _UNITS}
     return out
+
+
+def _pooled(summaries: list) -> dict:
+    """One type's grating summary over seeds: mean rate, median of the medians (None when none has one)."""
+    def median(key):
+        values = [v[key] for v in summaries if v.get(key) is not None]
+        return float(np.median(values)) if values else None
+    return {"rate": float(np.mean([v["rate"] for v in summaries])), "first_spike_s": median("first_spike_s"),
+            "vs": median("vs")}
 
 
 def _grating_summary(pop, seed: int) -> dict:
@@ -143,13 +168,19 @@ def main(argv=None) -> int:
     """Print the side-by-side table (module docstring)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--touchsim", required=True, help="TouchSim's recorded responses (JSON)")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=0, help="the noise seed")
+    parser.add_argument("--fingertips", default=",".join(map(str, HELD_OUT_SEEDS)),
+                        help="comma-separated fingertip seeds whose nearest units to compare (default: the seeds the "
+                             "transduction fit held out)")
     args = parser.parse_args(argv)
     with open(args.touchsim) as f:
         recording = json.load(f)
-    ours = ddmm_responses(args.seed)
+    seeds = tuple(int(v) for v in args.fingertips.split(","))
+    ours = ddmm_responses(args.seed, seeds)
     from ddmm.experiments.calibration.displacement import is_fitted_cell
 
+    held = "held out" if not set(seeds) & set(FIT_SEEDS) else "seen by the fit"
+    print(f"ddmm: the nearest units of fingertip seeds {', '.join(map(str, seeds))} ({held})")
     print("stimulus | role | type | ddmm imp/s | TouchSim imp/s | ratio | ddmm first spike s | TouchSim first spike s")
     for name, (_, key) in {**named_list(), "grating_40mm_s": (None, ("grating", None))}.items():
         theirs, role = touchsim_summary(recording, key), "fitted" if is_fitted_cell(name) else "held out"

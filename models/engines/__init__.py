@@ -9,6 +9,7 @@ whatever the step, so changing dt changes only the integration error.
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass
 
@@ -108,9 +109,11 @@ def substeps_for(fs: float, dt: float) -> int:
     ratio = 1.0 / (fs * dt)
     n = int(round(ratio))
     if n < 1 or abs(ratio - n) > 1e-9 * max(1.0, ratio):
+        rates = sorted({1.0 / (k * dt) for k in (max(1, math.floor(ratio)), max(1, math.ceil(ratio)))})
         raise ValueError(
             f"dt={dt:g} s ({dt * 1e3:g} ms) must divide the sample interval 1/fs = {1.0 / fs:g} s "
-            f"({1e3 / fs:g} ms) a whole number of times"
+            f"({1e3 / fs:g} ms) a whole number of times; the nearest rates it divides: "
+            f"{' and '.join(f'{r:g} Hz' for r in rates)} (or choose a dt that divides 1/fs)"
         )
     return n
 

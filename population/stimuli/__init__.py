@@ -9,8 +9,9 @@
 - `site_scenes`: scenes only force fields can express (torsion, slip, grasp);
 - `contact`: the skin's contact mechanics (rigid pins on an elastic half-space: loads, stress at
   depth, stick and slip);
-- `indentation`: indentation stimuli (probes, bars, pin arrays; ramps, vibration, noise, taps) as
-  scenes through the mechanics, and `indentation_spec` their settings tables (``ddmm simulate --indent``);
+- `indentation`: indentation stimuli (probes, bars, pin arrays) as scenes through the mechanics, with
+  `waveforms` their depths over time (ramps, vibration, noise, taps) and `indentation_spec` their settings
+  tables (``ddmm simulate --indent``);
 - `transduction`: each type's front end from the stress at its receptor depth to its drive (gain and
   lead-lag; fitted to TouchSim's responses);
 - `surfaces`: textured surfaces (gratings, dot patterns, embossed letters, bitmaps) scanned across the
@@ -27,8 +28,8 @@ _WHERE = {
     "site_scenes": ("contact_grid", "digit_tip_sites", "grasp", "incipient_slip", "torsion"),
     "contact": ("SKIN_MODELS", "SkinMechanics", "get_skin_mechanics", "normal_stress", "solve_pin_loads",
                 "stress_kernel", "tangential_loads"),
-    "indentation": ("Pins", "band_noise", "bar_pins", "circle_pins", "impulse", "indent", "pin_array", "probe",
-                    "ramp_hold", "sinusoid"),
+    "indentation": ("Pins", "bar_pins", "circle_pins", "indent", "pin_array", "probe"),
+    "waveforms": ("band_noise", "impulse", "ramp_hold", "sinusoid"),
     "indentation_spec": ("indentation_from_dict",),
     "transduction": ("TRANSDUCTIONS", "Transduction", "get_transduction"),
     "surfaces": ("Surface", "dot_pattern", "from_bitmap", "grating", "letters", "min_scan_fs", "scan"),

@@ -225,7 +225,8 @@ def effective_radius(x_mm, y_mm, radius_mm, skin) -> float:
 
     With ``skin.cap_pin_radius`` (TouchSim) it is ``min(radius_mm, smallest
     spacing / 2)``; otherwise ``radius_mm`` itself, and pins closer than
-    ``2 * radius_mm`` are refused.  Coincident pins are refused by both.
+    ``2 * radius_mm`` are refused (touching pins, up to a relative 1e-9 of
+    rounding, are not).  Coincident pins are refused by both.
 
     Examples
     --------
@@ -248,9 +249,11 @@ def effective_radius(x_mm, y_mm, radius_mm, skin) -> float:
         raise ValueError(f"pins {i} and {j} coincide at ({shown(x[i])}, {shown(y[i])}) mm; give each pin its own place")
     if skin.cap_pin_radius:
         return min(a, nearest / 2.0)
-    if nearest < 2.0 * a:
+    if nearest < 2.0 * a * (1.0 - 1e-9):  # touching pins (a bar's, a disc's) are 2a apart up to rounding
         raise ValueError(f"pins {i} and {j} overlap: centres {shown(nearest)} mm apart, less than 2 * radius_mm = "
-                         f"{shown(2 * a)} mm (the {skin.name!r} skin keeps pin radii; use a smaller radius_mm)")
+                         f"{shown(2 * a)} mm (the {skin.name!r} skin keeps pin radii: use a smaller radius_mm, "
+                         "more room between the pins (pitch_mm) or the 'touchsim' skin, which caps radii at half "
+                         "the spacing)")
     return a
 
 

@@ -6,8 +6,9 @@ A TouchSim user thinks in skin displacement: a probe indented 0.5 mm, a
 `ddmm.population.stimuli.contact`:
 
 1. the pins (`Pins`: `probe`, `bar_pins`, `circle_pins`, `pin_array`) and a
-   depth waveform per pin (`ramp_hold`, `sinusoid`, `band_noise`,
-   `impulse`, or any array) give each sample's indentation in mm;
+   depth waveform per pin (`ddmm.population.stimuli.waveforms`: `ramp_hold`,
+   `sinusoid`, `band_noise`, `impulse`, or any array) give each sample's
+   indentation in mm;
 2. the skin (``skin="default"`` or ``"touchsim"``, `SkinMechanics`) gives
    each pin's normal load (N; pins in contact only, none pulls), and a pin
    moved sideways (``lateral_mm``) its tangential load by Coulomb stick and
@@ -46,15 +47,17 @@ from ddmm.population.stimuli.contact import (
 )
 from ddmm.population.stimuli.scenes import REFERENCE_AREA_MM2, Scene, Sites
 from ddmm.population.stimuli.transduction import get_transduction
+from ddmm.population.stimuli.waveforms import INDENT_FS, band_noise, impulse, ramp_hold, sinusoid
+from ddmm.utils.resources import check_memory
 from ddmm.utils.validation import as_finite_array, check_nonnegative, check_positive, check_real, shown
 
 __all__ = ["ContactSpread", "Pins", "bar_pins", "band_noise", "circle_pins", "impulse", "indent", "pin_array",
            "probe", "ramp_hold", "sinusoid"]
 
-#: Default sample rate of indentation stimuli in Hz (TouchSim's): FA-II's band needs 750 Hz at least.
-INDENT_FS = 5000.0
 #: Longest indentation in mm a pin may be given: deeper than the fingertip pad's soft tissue.
 MAX_DEPTH_MM = 10.0
+#: Most pins a stimulus may use (the contact solve is cubic in the touching pins).
+MAX_PINS = 4000
 
 
 @dataclass(frozen=True, eq=False)
@@ -141,7 +144,7 @@ def bar_pins(width_mm: float = 1.0, height_mm: float = 0.5, *, angle_deg: float 
              center_mm=(0.0, 0.0)) -> Pins:
     """A bar ``width_mm`` x ``height_mm`` tiled by pins (``pins_per_mm``), turned by ``angle_deg`` from +X.
 
-    The pins' radius is half their spacing, so they tile the bar.
+    The pins' radius is half their spacing, so they tile the bar; at most `MAX_PINS` pins.
 
     Examples
     --------
@@ -152,7 +155,10 @@ def bar_pins(width_mm: float = 1.0, height_mm: float = 0.5, *, angle_deg: float 
         check_positive(v, name, "mm" if name != "pins_per_mm" else "per mm")
     check_real(angle_deg, "angle_deg", "deg")
     step = 1.0 / pins_per_mm
-    nx, ny = max(1, int(round(width_mm * pins_per_mm))), max(1, int(round(height_mm * pins_per_mm)))
+    nx, ny = (max(1.0, float(np.rint(side * pins_per_mm))) for side in (width_mm, height_mm))
+    _check_pin_count(nx * ny, "bar", f"of {shown(width_mm)} x {shown(height_mm)} mm at "
+                     f"pins_per_mm={shown(pins_per_mm)}")
+    nx, ny = int(nx), int(ny)
     gx, gy = np.meshgrid((np.arange(nx) - (nx - 1) / 2.0) * step, (np.arange(ny) - (ny - 1) / 2.0) * step)
     a = np.deg2rad(angle_deg)
     x, y = gx.ravel() * np.cos(a) - gy.ravel() * np.sin(a), gx.ravel() * np.sin(a) + gy.ravel() * np.cos(a)
@@ -163,7 +169,7 @@ def bar_pins(width_mm: float = 1.0, height_mm: float = 0.5, *, angle_deg: float 
 def circle_pins(radius_mm: float = 2.0, *, pins_per_mm: float = 10.0, curvature_mm: float = 0.0,
                 center_mm=(0.0, 0.0)) -> Pins:
     """A disc of radius ``radius_mm`` tiled by pins; with ``curvature_mm`` > 0 a dome whose edge sits that much
-    higher than its centre (a sphere's cap, read as a parabola).
+    higher than its centre (a sphere's cap, read as a parabola); at most `MAX_PINS` pins.
 
     Examples
     --------
@@ -175,13 +181,24 @@ def circle_pins(radius_mm: float = 2.0, *, pins_per_mm: float = 10.0, curvature_
     check_positive(pins_per_mm, "pins_per_mm", "per mm")
     check_nonnegative(curvature_mm, "curvature_mm", "mm")
     step = 1.0 / pins_per_mm
-    n = max(1, int(round(2.0 * radius_mm * pins_per_mm)))
-    axis = (np.arange(n) - (n - 1) / 2.0) * step
+    n = max(1.0, float(np.rint(2.0 * radius_mm * pins_per_mm)))
+    what = f"of radius {shown(radius_mm)} mm at pins_per_mm={shown(pins_per_mm)}"
+    if n * n > 4 * MAX_PINS:  # too many to build: the disc holds about pi / 4 of its square's n^2 points
+        _check_pin_count(np.pi / 4.0 * n * n, "disc", what)
+    axis = (np.arange(int(n)) - (n - 1) / 2.0) * step
     gx, gy = (g.ravel() for g in np.meshgrid(axis, axis))
     inside = np.hypot(gx, gy) <= radius_mm
+    _check_pin_count(np.count_nonzero(inside), "disc", what)
     offset = -curvature_mm * (np.hypot(gx, gy)[inside] / radius_mm) ** 2
     cx, cy = _centre(center_mm)
     return Pins(gx[inside] + cx, gy[inside] + cy, step / 2.0, offset)
+
+
+def _check_pin_count(count: float, shape: str, what: str) -> None:
+    """Refuse a ``shape`` (``"bar"``, ``"disc"``) of more than `MAX_PINS` pins, before building it."""
+    if count > MAX_PINS:
+        raise ValueError(f"a {shape} {what} would take about {count:.0f} pins, more than the {MAX_PINS} allowed; use a "
+                         f"lower pins_per_mm or a smaller {shape}")
 
 
 def _centre(center_mm) -> tuple:
@@ -222,7 +239,8 @@ class ContactSpread:
 
     def input_sections(self, fs: float) -> dict:
         """{type code: filter sections at ``fs`` Hz} of the types whose transduction filters (for
-        `ddmm.models.fused.FusedPipeline`'s ``input_sections``)."""
+        `ddmm.models.fused.FusedPipeline`'s ``input_sections``); a corner at or above ``fs / 2`` is
+        compressed towards it, not refused (`ddmm.population.stimuli.transduction.Transduction.sections`)."""
         out = {kind: t.sections(fs) for kind, t in self.transduction}
         return {kind: sos for kind, sos in out.items() if sos is not None}
 
@@ -285,133 +303,6 @@ def skin_gap_mm(population, tree=None) -> float:
     return max(2.0, 2.0 * float(np.median(spacing[:, 1])))
 
 
-def _timebase(duration_s: float, fs: float) -> np.ndarray:
-    check_positive(duration_s, "duration_s", "s")
-    check_positive(fs, "fs", "Hz")
-    n = int(round(duration_s * fs))
-    if n < 2:
-        raise ValueError(f"duration_s={float(duration_s):g} s at fs={float(fs):g} Hz gives {n} sample(s); need 2 or more")
-    return np.arange(n) / fs
-
-
-def _envelope(n: int, ramp_s: float, fs: float) -> np.ndarray:
-    """Linear on and off ramps of ``ramp_s`` each (0: none) over ``n`` samples."""
-    check_nonnegative(ramp_s, "ramp_s", "s")
-    k = int(round(ramp_s * fs))
-    if 2 * k > n:
-        raise ValueError(f"ramp_s={float(ramp_s):g} s is longer than half the stimulus ({n / fs:g} s)")
-    env = np.ones(n)
-    if k:
-        env[:k] = np.linspace(0.0, 1.0, k)
-        env[n - k:] = np.linspace(1.0, 0.0, k)
-    return env
-
-
-def _checked_depth(depth: np.ndarray, what: str) -> np.ndarray:
-    if np.any(depth < 0.0):
-        i = int(np.argmax(depth < 0.0))
-        raise ValueError(f"{what} leaves the skin: depth {float(depth[i]):g} mm at sample {i}; raise pre_indent_mm "
-                         "so the probe stays in contact")
-    return depth
-
-
-def ramp_hold(depth_mm: float, *, ramp_s: float = 0.05, hold_s: float = 0.5, fs: float = INDENT_FS) -> np.ndarray:
-    """Depth (mm) of a ramp-and-hold indentation: a linear ramp to ``depth_mm`` over ``ramp_s``, a hold of
-    ``hold_s``, and a ramp back over ``ramp_s``, sampled at ``fs`` Hz.
-
-    Examples
-    --------
-    >>> d = ramp_hold(0.5, ramp_s=0.1, hold_s=0.2, fs=1000.0)
-    >>> d.size, float(d.max())
-    (400, 0.5)
-    """
-    check_nonnegative(depth_mm, "depth_mm", "mm")
-    check_positive(hold_s, "hold_s", "s")
-    t = _timebase(2.0 * ramp_s + hold_s, fs)
-    return float(depth_mm) * _envelope(t.size, ramp_s, fs)
-
-
-def sinusoid(freq_hz: float, amplitude_mm: float, *, pre_indent_mm: float, duration_s: float = 1.0,
-             ramp_s: float = 0.05, phase_deg: float = 0.0, fs: float = INDENT_FS) -> np.ndarray:
-    """Depth (mm) of a vibration ``amplitude_mm`` at ``freq_hz`` about a pre-indentation, both ramped in and out.
-
-    The probe must stay in the skin (``amplitude_mm <= pre_indent_mm``) and the rate carry the
-    frequency (``freq_hz < fs / 2``).
-
-    Examples
-    --------
-    >>> d = sinusoid(50.0, 0.05, pre_indent_mm=0.3, duration_s=0.2, fs=2000.0)
-    >>> round(float(d.max()), 3) <= 0.35
-    True
-    """
-    check_positive(freq_hz, "freq_hz", "Hz")
-    check_nonnegative(amplitude_mm, "amplitude_mm", "mm")
-    check_nonnegative(pre_indent_mm, "pre_indent_mm", "mm")
-    check_real(phase_deg, "phase_deg", "deg")
-    if freq_hz >= fs / 2.0:
-        raise ValueError(f"freq_hz={float(freq_hz):g} Hz needs fs above {2.0 * freq_hz:g} Hz, got fs={float(fs):g} Hz")
-    if amplitude_mm > pre_indent_mm:
-        raise ValueError(f"amplitude_mm={float(amplitude_mm):g} mm exceeds pre_indent_mm={float(pre_indent_mm):g} "
-                         "mm: the probe would leave the skin each cycle")
-    t = _timebase(duration_s, fs)
-    wave = pre_indent_mm + amplitude_mm * np.sin(2.0 * np.pi * freq_hz * t + np.deg2rad(phase_deg))
-    return _checked_depth(wave * _envelope(t.size, ramp_s, fs), "the sinusoid")
-
-
-def band_noise(low_hz: float, high_hz: float, sd_mm: float, *, pre_indent_mm: float, duration_s: float = 1.0,
-               ramp_s: float = 0.05, fs: float = INDENT_FS, rng=None) -> np.ndarray:
-    """Depth (mm) of band-limited Gaussian noise (standard deviation ``sd_mm``, 3rd-order Butterworth band
-    ``low_hz``-``high_hz``) about a pre-indentation, ramped in and out; ``rng`` a Generator, a seed or None.
-
-    Examples
-    --------
-    >>> d = band_noise(100.0, 300.0, 0.01, pre_indent_mm=0.3, duration_s=0.5, rng=0)
-    >>> bool(d.min() >= 0.0)
-    True
-    """
-    from scipy.signal import butter, sosfilt
-
-    from ddmm.utils.validation import check_rng
-
-    check_positive(low_hz, "low_hz", "Hz")
-    check_positive(sd_mm, "sd_mm", "mm")
-    check_nonnegative(pre_indent_mm, "pre_indent_mm", "mm")
-    if not low_hz < high_hz < fs / 2.0:
-        raise ValueError(f"need low_hz < high_hz < fs / 2; got {float(low_hz):g}, {float(high_hz):g} Hz at "
-                         f"fs={float(fs):g} Hz")
-    t = _timebase(duration_s, fs)
-    raw = check_rng(rng).standard_normal(t.size)
-    band = sosfilt(butter(3, [low_hz, high_hz], btype="bandpass", fs=fs, output="sos"), raw)
-    wave = pre_indent_mm + sd_mm * band / np.std(band)
-    return _checked_depth(wave * _envelope(t.size, ramp_s, fs), "the noise")
-
-
-def impulse(amplitude_mm: float, *, width_s: float = 0.01, pad_s: float = 0.045, pre_indent_mm: float = 0.0,
-            fs: float = INDENT_FS) -> np.ndarray:
-    """Depth (mm) of a brief tap: a Gaussian pulse of peak ``amplitude_mm`` over ``width_s`` (+-3 SD) on a
-    pre-indentation, with ``pad_s`` of the pre-indentation before and after.
-
-    Examples
-    --------
-    >>> d = impulse(0.03, fs=5000.0)
-    >>> d.size, float(d.max())
-    (501, 0.03)
-    """
-    check_positive(amplitude_mm, "amplitude_mm", "mm")
-    check_nonnegative(pad_s, "pad_s", "s")
-    check_nonnegative(pre_indent_mm, "pre_indent_mm", "mm")
-    check_positive(width_s, "width_s", "s")
-    check_positive(fs, "fs", "Hz")
-    n = int(round(width_s * fs))
-    if n < 5:
-        raise ValueError(f"width_s={float(width_s):g} s is {n} samples at fs={float(fs):g} Hz; a pulse needs 5 "
-                         "or more: raise fs or width_s")
-    x = np.linspace(-3.0, 3.0, n | 1)  # an odd count: the peak falls on a sample
-    pulse = amplitude_mm * np.exp(-0.5 * x * x)
-    pad = np.zeros(int(round(pad_s * fs)))
-    return pre_indent_mm + np.concatenate([pad, pulse, pad])
-
-
 def indent(pins: Pins, depth_mm, *, fs: float = INDENT_FS, lateral_mm=None, skin="default",
            transduction="fitted", name: str = "indentation") -> Scene:
     """A scene of ``pins`` pressed into the skin by ``depth_mm``, through the skin's mechanics.
@@ -451,7 +342,7 @@ def indent(pins: Pins, depth_mm, *, fs: float = INDENT_FS, lateral_mm=None, skin
     if not isinstance(pins, Pins):
         raise TypeError(f"pins must be a Pins (probe, bar_pins, circle_pins, pin_array), got {type(pins).__name__}")
     skin = get_skin_mechanics(skin) if isinstance(skin, str) else skin
-    depth = _pin_depths(depth_mm, pins)
+    depth = _pin_depths(depth_mm, pins, lateral_mm is not None)
     check_positive(fs, "fs", "Hz")
     radius = effective_radius(pins.x_mm, pins.y_mm, pins.radius_mm, skin)
     loads = solve_pin_loads(depth, pins.x_mm, pins.y_mm, radius, skin)
@@ -464,7 +355,17 @@ def indent(pins: Pins, depth_mm, *, fs: float = INDENT_FS, lateral_mm=None, skin
     return Scene.from_sites(forces, sites, fs=fs, name=name)
 
 
-def _pin_depths(depth_mm, pins: Pins) -> np.ndarray:
+def _indent_bytes(n_samples: int, n_pins: int, lateral: bool, held: int = 1) -> float:
+    """Peak resident bytes of `indent` on ``n_samples`` x ``n_pins`` (its caller holding ``held`` such float64
+    arrays), checked against scans' measured peaks: its largest phase in (samples, pins) and (pins, pins) arrays,
+    the compliance (1 and 4.25 square), the solve (5.75 and 3.25 square) or with ``lateral`` the friction (11:
+    forces, motion, ...), and two freed square arrays the allocator keeps (glibc: those under 32 MiB)."""
+    el, sq = float(n_samples) * n_pins, float(n_pins) ** 2
+    phases = ((held + 1.0) * el + 4.25 * sq, (held + 5.75) * el + 3.25 * sq, (held + 11.0) * el * lateral)
+    return 8.0 * max(phases) + 2.0 * min(8.0 * sq, 32 << 20)
+
+
+def _pin_depths(depth_mm, pins: Pins, lateral: bool) -> np.ndarray:
     """(n_samples, n_pins) depths in mm: the waveform (validated >= 0) plus each pin's offset, floored at 0."""
     depth = as_finite_array(depth_mm, "depth_mm")
     if depth.ndim == 1:
@@ -478,6 +379,8 @@ def _pin_depths(depth_mm, pins: Pins) -> np.ndarray:
                          f"pin {int(j)}")
     if np.any(depth > MAX_DEPTH_MM):
         raise ValueError(f"depth_mm must be <= {MAX_DEPTH_MM:g} mm, got {float(depth.max()):g}")
+    check_memory(_indent_bytes(depth.shape[0], len(pins), lateral), f"an indentation of {depth.shape[0]} samples x "
+                 f"{len(pins)} pins", "use fewer pins or samples")
     return np.maximum(depth + pins.offset_mm[None, :], 0.0)
 
 

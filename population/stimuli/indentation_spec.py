@@ -20,8 +20,9 @@ file) names a waveform ``kind`` and its settings, the pins and the skin:
 - ``skin``: ``default`` or ``touchsim``; ``transduction``: ``fitted`` (default) or ``none``
   (`ddmm.population.stimuli.transduction`); ``name``: the condition's name.
 
-Every unknown key, kind or pin shape is refused with a `ValueError` naming it
-and what is allowed.
+Every unknown key, kind or pin shape, and a key given twice, is refused with a
+`ValueError` naming it and what is allowed; a value that is not text or a
+number (a TOML table or list) with a `TypeError` naming its key.
 """
 
 from __future__ import annotations
@@ -48,6 +49,8 @@ PIN_SHAPES = {
     "circle": ("disc_radius_mm", "curvature_mm", "pins_per_mm", "x_mm", "y_mm"),
 }
 _COMMON = ("kind", "fs", "pins", "lateral_mm", "lateral_deg", "skin", "transduction", "name")
+#: The settings that are text (every other one is a number).
+_TEXT = ("kind", "pins", "skin", "transduction", "name")
 
 
 def indentation_from_dict(table: dict):
@@ -62,6 +65,10 @@ def indentation_from_dict(table: dict):
     """
     if not isinstance(table, dict):
         raise TypeError(f"an indentation must be a table of settings, got {type(table).__name__}")
+    for key, value in table.items():  # a TOML file may give a table, a list or a date: refused by key
+        if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+            got = {dict: "a table", list: "a list"}.get(type(value), type(value).__name__)
+            raise TypeError(f"indent key {key!r} must be {'text' if key in _TEXT else 'a number'}, got {got}")
     kind = table.get("kind")
     if kind not in KINDS:
         raise ValueError(f"indent kind {kind!r} is unknown; allowed: {', '.join(KINDS)}")
@@ -86,7 +93,9 @@ def indentation_from_dict(table: dict):
 
 
 def _pins(shape: str, table: dict):
-    centre = (table.get("x_mm", 0.0), table.get("y_mm", 0.0))
+    from ddmm.utils.validation import check_positive, check_real
+
+    centre = tuple(check_real(table.get(key, 0.0), key, "mm") for key in ("x_mm", "y_mm"))
     if shape == "probe":
         return ind.probe(*centre, radius_mm=table.get("radius_mm", 0.5))
     if shape == "array":
@@ -96,7 +105,8 @@ def _pins(shape: str, table: dict):
         return ind.bar_pins(table.get("width_mm", 1.0), table.get("height_mm", 0.5),
                             angle_deg=table.get("angle_deg", 0.0), pins_per_mm=table.get("pins_per_mm", 10.0),
                             center_mm=centre)
-    return ind.circle_pins(table.get("disc_radius_mm", 2.0), curvature_mm=table.get("curvature_mm", 0.0),
+    radius = check_positive(table.get("disc_radius_mm", 2.0), "disc_radius_mm", "mm")  # named as the table names it
+    return ind.circle_pins(radius, curvature_mm=table.get("curvature_mm", 0.0),
                            pins_per_mm=table.get("pins_per_mm", 10.0), center_mm=centre)
 
 
@@ -139,6 +149,8 @@ def parse_indent_option(text: str) -> dict:
         key, eq, value = item.partition("=")
         if not eq or not key.strip():
             raise ValueError(f"--indent settings must be key=value, got {item!r}")
+        if key.strip() in table:
+            raise ValueError(f"--indent key {key.strip()!r} is given twice; give each key once")
         try:
             table[key.strip()] = parse_number(value.strip())
         except ValueError:

@@ -27,17 +27,19 @@ its centre, rows along +Y (row 0 the lowest y) and columns along +X.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ddmm.population.stimuli._contact_kernels import bilinear
 from ddmm.population.stimuli.contact import SkinMechanics, get_skin_mechanics
-from ddmm.population.stimuli.indentation import MAX_DEPTH_MM, Pins, indent
+from ddmm.population.stimuli.indentation import MAX_DEPTH_MM, MAX_PINS, Pins, _indent_bytes, indent
 from ddmm.utils.resources import check_memory
 from ddmm.utils.validation import (
     as_finite_array,
     check_instance,
+    check_nonnegative,
     check_positive,
     check_real,
     shown,
@@ -51,8 +53,8 @@ MAX_WINDOW_MM = 20.0
 MIN_PITCH_MM = 0.05
 #: Fastest scan in mm/s (free exploration of textures runs at 10-300 mm/s).
 MAX_SPEED_MM_S = 500.0
-#: Most pins a scan may use (the contact solve is cubic in the touching pins).
-MAX_PINS = 4000
+#: The lowest sample rate in Hz `scan` picks when given none: the fitted transduction's 1000 Hz corner below Nyquist.
+MIN_DEFAULT_FS = 2500.0
 
 #: A 5 x 7 bitmap font of the capitals and digits: 7 rows (top first) of 5 columns, ``#`` raised.
 FONT_5X7 = {
@@ -345,19 +347,35 @@ def letters(text: str, *, height_mm: float = 6.0, relief_mm: float = 0.5, pixel_
 
 
 def min_scan_fs(speed_mm_s: float, pixel_mm: float) -> float:
-    """The lowest sample rate (Hz) `scan` accepts: ``2 * speed_mm_s / pixel_mm``.
+    """The lowest sample rate (Hz) of a scan `simulate` runs at its default step: the smallest rate at or above
+    ``2 * speed_mm_s / pixel_mm`` whose sample interval is a whole number of 0.1 ms steps (``10000 / k`` Hz).
 
-    The surface then moves at most half a pixel between samples, so its
-    finest detail (a period of two pixels, at ``speed / (2 pixel)`` Hz) gets
-    at least 4 samples a cycle, and the bilinear height between pixel centres
-    at least 2 samples per pixel.
+    `scan` refuses a rate below ``2 * speed_mm_s / pixel_mm``: the surface
+    then moves at most half a pixel between samples, so its finest detail (a
+    period of two pixels, at ``speed / (2 pixel)`` Hz) gets at least 4
+    samples a cycle, and the bilinear height between pixel centres at least
+    2 samples per pixel.  Above 10 kHz no rate is a whole number of 0.1 ms
+    steps: that bound itself is returned, and `simulate` needs a ``dt`` that
+    divides its interval.
 
     Examples
     --------
-    >>> min_scan_fs(40.0, 0.05)
-    1600.0
+    >>> min_scan_fs(40.0, 0.05)  # 1600 Hz is 0.625 ms: 10000 / 6 Hz is the next whole number of steps
+    1666.6666666666667
+    >>> min_scan_fs(50.0, 0.05)
+    2000.0
     """
-    return 2.0 * check_positive(speed_mm_s, "speed_mm_s", "mm/s") / check_positive(pixel_mm, "pixel_mm", "mm")
+    speed = check_positive(speed_mm_s, "speed_mm_s", "mm/s")
+    return _stepped_rate(2.0 * speed / check_positive(pixel_mm, "pixel_mm", "mm"))
+
+
+def _stepped_rate(need_hz: float) -> float:
+    """The smallest rate >= ``need_hz`` (up to rounding) whose interval is a whole number of `simulate`'s default
+    steps (`ddmm.population.simulation.DEFAULT_DT`); ``need_hz`` itself above one step's rate."""
+    from ddmm.population.simulation import DEFAULT_DT
+
+    top = 1.0 / DEFAULT_DT
+    return need_hz if need_hz > top else top / math.floor(min(top / need_hz, 1e15) * (1.0 + 1e-9))
 
 
 def _window_pins(window_mm, pitch_mm: float, center_mm) -> Pins:
@@ -396,17 +414,21 @@ def _check_scan(surface, speed_mm_s, contact_mm, fs) -> tuple:
     contact = check_positive(contact_mm, "contact_mm", "mm")
     if contact > MAX_DEPTH_MM:
         raise ValueError(f"contact_mm={shown(contact)} mm must be <= {MAX_DEPTH_MM:g} mm")
+    need = 2.0 * speed / surface.pixel_mm
+    if fs is None:  # the default: a rate simulate's default step divides
+        return speed, contact, _stepped_rate(max(need, MIN_DEFAULT_FS))
     fs = check_positive(fs, "fs", "Hz")
-    need = min_scan_fs(speed, surface.pixel_mm)
-    if fs < need:
+    if fs < need * (1.0 - 1e-9):
         raise ValueError(f"fs={shown(fs)} Hz is too slow for a surface of pixel_mm={shown(surface.pixel_mm)} mm at "
-                         f"speed_mm_s={shown(speed)} mm/s: need fs >= 2 * speed / pixel = {need:g} Hz")
+                         f"speed_mm_s={shown(speed)} mm/s: need fs >= 2 * speed / pixel = {need:g} Hz (min_scan_fs "
+                         f"gives {_stepped_rate(need):g} Hz, a whole number of simulate's 0.1 ms steps)")
     return speed, contact, fs
 
 
 def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0.0, duration_s: float = 1.0,
          contact_mm: float = 0.8, window_mm=(8.0, 8.0), pitch_mm: float = 0.2, friction: bool = True,
-         fs: float = 2000.0, skin="default", transduction="fitted", center_mm=(0.0, 0.0), name: str | None = None):
+         fs: float | None = None, skin="default", transduction="fitted", center_mm=(0.0, 0.0), ramp_s: float = 0.0,
+         name: str | None = None):
     """A scene of ``surface`` pressed into the skin and slid across it at constant velocity.
 
     The surface's centre passes under ``center_mm`` half-way through the
@@ -434,14 +456,21 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
         True: the surface drags each touching pin (stick, then slip at
         ``skin.friction * P`` along the motion); False: the same skin with
         no friction (no tangential loads).
-    fs : float
+    fs : float, optional
         Sample rate in Hz, at least ``2 * speed_mm_s / surface.pixel_mm``
-        (`min_scan_fs`: the surface moves at most half a pixel a sample).
+        (the surface moves at most half a pixel a sample).  Default: the
+        smallest rate at or above that and `MIN_DEFAULT_FS` (2500 Hz) whose
+        interval is a whole number of `simulate`'s 0.1 ms steps
+        (`min_scan_fs`): 2500 Hz up to 62.5 mm/s on a 0.05 mm pixel.
     skin : str or SkinMechanics
     transduction : str or mapping
         Each type's front end from stress to drive (`indent`'s).
     center_mm : (float, float)
         Centre of the window in mm.
+    ramp_s : float
+        Time in s over which the surface is lowered into the skin, its depths
+        scaled by ``t / ramp_s`` while it already slides; 0 (default, as
+        TouchSim's traces): at full depth from the first sample.
     name : str, optional
         The scene's name (default from the speed and direction).
 
@@ -453,24 +482,31 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
     Examples
     --------
     >>> s = scan(grating(1.0), duration_s=0.05, window_mm=(2.0, 2.0), pitch_mm=0.5)
-    >>> s.n_sites, s.n_samples, bool(s.fz.max() > 0), bool(s.fx.max() > 0)
-    (16, 100, True, True)
+    >>> s.n_sites, s.n_samples, s.fs, bool(s.fz.max() > 0), bool(s.fx.max() > 0)
+    (16, 125, 2500.0, True, True)
     """
     speed, contact, fs = _check_scan(surface, speed_mm_s, contact_mm, fs)
     angle = np.deg2rad(check_real(direction_deg, "direction_deg", "deg"))
     duration = check_positive(duration_s, "duration_s", "s")
+    ramp = check_nonnegative(ramp_s, "ramp_s", "s")
+    if ramp > duration:
+        raise ValueError(f"ramp_s={shown(ramp)} s must be at most duration_s={shown(duration)} s")
     pins = _window_pins(window_mm, check_positive(pitch_mm, "pitch_mm", "mm"), center_mm)
     skin = _scan_skin(skin, friction)
+    # `indent`'s peak while the scan holds the heights and the depths (two more (samples, pins) arrays)
+    check_memory(_indent_bytes(duration * fs, len(pins), friction, held=2), f"a scan of {duration * fs:.0f} samples "
+                 f"x {len(pins)} pins", "use fewer pins or samples")
     n = round(duration * fs)
     if n < 2:
         raise ValueError(f"duration_s={shown(duration)} s at fs={shown(fs)} Hz gives {n} sample(s); need 2 or more")
-    check_memory(64.0 * n * len(pins), f"a scan of {n} samples x {len(pins)} pins", "use fewer pins or samples")
     travel = speed * (np.arange(n) / fs)  # mm along the direction
     unit = np.array([np.cos(angle), np.sin(angle)])
     shift = (travel - speed * duration / 2.0)[:, None] * unit[None, :]
     centre = np.array([pins.x_mm.mean(), pins.y_mm.mean()])
     h = surface.height_at(pins.x_mm[None, :] - centre[0] - shift[:, :1], pins.y_mm[None, :] - centre[1] - shift[:, 1:])
     depth = np.maximum(contact - (surface.max_height_mm - h), 0.0)
+    if ramp > 0.0:  # lowered in while it slides: the onset no longer steps every pin at once
+        depth *= np.minimum(np.arange(n) / (ramp * fs), 1.0)[:, None]
     lateral = travel[:, None] * unit[None, :] if friction else None
     name = f"scan_{speed:g}mm_s_{np.rad2deg(angle):g}deg" if name is None else name
     return indent(pins, depth, fs=fs, lateral_mm=lateral, skin=skin, transduction=transduction, name=name)

@@ -28,11 +28,13 @@ path).  The fit, its split and what it holds out: docs/model.md,
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from types import MappingProxyType
 
 from ddmm.models.afferent_types import normalize_type
 from ddmm.models.current_filters import lead_lag_sos
+from ddmm.utils.validation import shown
 
 __all__ = ["TRANSDUCTIONS", "Transduction", "get_transduction"]
 
@@ -61,17 +63,14 @@ class Transduction:
     pole_hz: float | None = None
 
     def __post_init__(self):
-        if isinstance(self.gain, bool) or not isinstance(self.gain, (int, float)) or not (
-                math.isfinite(self.gain) and self.gain > 0):
-            raise ValueError(f"gain must be a finite number > 0, got {self.gain!r}")
+        object.__setattr__(self, "gain", _positive(self.gain, "gain", "a finite number > 0"))
         if (self.zero_hz is None) != (self.pole_hz is None):
-            raise ValueError(f"zero_hz and pole_hz must both be given or both None, got {self.zero_hz!r} and "
-                             f"{self.pole_hz!r}")
+            raise ValueError(f"zero_hz and pole_hz must both be given or both None, got {shown(self.zero_hz)} and "
+                             f"{shown(self.pole_hz)}")
         for name in ("zero_hz", "pole_hz"):
-            v = getattr(self, name)
-            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not (
-                    math.isfinite(v) and v > 0)):
-                raise ValueError(f"{name} must be a finite frequency > 0 in Hz or None, got {v!r}")
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, _positive(getattr(self, name), name,
+                                                         "a finite frequency > 0 in Hz or None"))
 
     @property
     def lead(self) -> bool:
@@ -79,19 +78,31 @@ class Transduction:
         return self.zero_hz is not None and self.zero_hz < self.pole_hz
 
     def sections(self, fs: float):
-        """The filter's section at ``fs`` Hz (shape (1, 6)), or None without a filter."""
+        """The filter's section at ``fs`` Hz (shape (1, 6)), or None without a filter.
+
+        A corner at or above ``fs / 2`` is not refused: the bilinear map (`lead_lag_sos`) compresses it
+        towards the Nyquist frequency.  The fitted set's largest corner, 1000 Hz, sits there at 2 kHz, a
+        rate indentation scenes run at (5 kHz, `ddmm.population.stimuli.waveforms.INDENT_FS`, by default).
+        """
         if self.zero_hz is None or self.zero_hz == self.pole_hz:
             return None
         return lead_lag_sos(self.zero_hz, self.pole_hz, fs)
+
+
+def _positive(value, name: str, allowed: str) -> float:
+    """``value`` as a plain float if it is a finite real number > 0 (a numpy scalar too; not a bool)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be {allowed}, got {shown(value)}")
+    return float(value)
 
 
 #: Named transduction sets, by type code (a type left out: unit gain, no filter).  ``"fitted"``: the values
 #: `ddmm.experiments.calibration.displacement` found (fitted; docs/model.md gives the fit's split and score).
 TRANSDUCTIONS = MappingProxyType({
     "fitted": MappingProxyType({
-        "SAI": Transduction(gain=0.1568, zero_hz=1.063, pole_hz=1000.0),
-        "RAI": Transduction(gain=0.09384, zero_hz=14.69, pole_hz=242.1),
-        "RAII": Transduction(gain=17.27, zero_hz=1000.0, pole_hz=9.652),
+        "SAI": Transduction(gain=0.2501, zero_hz=1.327, pole_hz=1000.0),
+        "RAI": Transduction(gain=0.04201, zero_hz=12.14, pole_hz=169.4),
+        "RAII": Transduction(gain=22.15, zero_hz=589.1, pole_hz=10.22),
     }),
     "none": MappingProxyType({}),
 })

@@ -78,6 +78,11 @@ def test_substeps_must_be_whole():
     assert substeps_for(1000.0, 1e-5) == 100
     with pytest.raises(ValueError, match="dt"):
         substeps_for(1000.0, 3e-4)
+    with pytest.raises(ValueError, match=r"\(0.3125 ms\) a whole number of times; the nearest rates it divides: "
+                                         r"2500 Hz and 3333.33 Hz \(or choose a dt that divides 1/fs\)$"):
+        substeps_for(3200.0, 1e-4)
+    with pytest.raises(ValueError, match=r"the nearest rates it divides: 10000 Hz \("):
+        substeps_for(20000.0, 1e-4)
 
 
 @pytest.mark.parametrize("kwargs,exc,match", [

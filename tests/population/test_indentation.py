@@ -1,5 +1,6 @@
 """Indentation stimuli (`ddmm.population.stimuli.indentation`): generators, the scene, and the model on it."""
 
+import re
 import subprocess
 import sys
 
@@ -72,6 +73,50 @@ def test_bad_stimuli_are_refused_in_one_line(make, message):
     with pytest.raises((ValueError, TypeError), match=message) as info:
         make()
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("pins_per_mm", [3.0, 5.0, 7.0, 10.0, 20.0])
+def test_bars_and_discs_of_touching_pins_are_not_refused_as_overlapping(pins_per_mm):
+    """A bar's and a disc's pins are 2 radii apart, up to rounding (0.1 mm read as 0.09999999999999998)."""
+    depth = ramp_hold(0.5, ramp_s=0.01, hold_s=0.01, fs=FS)
+    for pins in (bar_pins(pins_per_mm=pins_per_mm), bar_pins(angle_deg=30.0, pins_per_mm=pins_per_mm),
+                 circle_pins(1.0, pins_per_mm=pins_per_mm)):
+        assert indent(pins, depth, fs=FS).n_sites == len(pins) > 1
+    for shape in ("bar", "circle"):  # the defaults, as --indent ramp:depth_mm=0.5,pins=bar gives them
+        assert indentation_from_dict({"kind": "ramp", "depth_mm": 0.5, "hold_s": 0.01, "pins": shape}).n_sites > 1
+    with pytest.raises(ValueError, match=r"overlap: .* use a smaller radius_mm, more room between the pins "
+                                         r"\(pitch_mm\) or the 'touchsim' skin"):
+        indent(pin_array(1, 2, pitch_mm=1.0, radius_mm=0.6), depth, fs=FS)
+
+
+@pytest.mark.parametrize(("make", "message"), [
+    (lambda: ramp_hold(0.5, ramp_s=-1), r"^ramp_s must be a finite number >= 0 s, got -1$"),
+    (lambda: ramp_hold(0.5, hold_s=-1), r"^hold_s must be a finite number > 0 s, got -1$"),
+    (lambda: sinusoid(50.0, 0.1, pre_indent_mm=0.3, fs=None), r"^fs must be a real number, got NoneType$"),
+    (lambda: sinusoid(50.0, 0.1, pre_indent_mm=0.3, ramp_s=-1), r"^ramp_s must be .*, got -1$"),
+    (lambda: sinusoid(50.0, 0.1, pre_indent_mm=0.3, duration_s=-1), r"^duration_s must be .*, got -1$"),
+    (lambda: band_noise(100.0, 300.0, 0.01, pre_indent_mm=0.3, fs=None), r"^fs must be a real number, got NoneType$"),
+    (lambda: band_noise(100.0, None, 0.01, pre_indent_mm=0.3), r"^high_hz must be a real number, got NoneType$"),
+    (lambda: band_noise(100.0, 300.0, 0.01, pre_indent_mm=0.3, ramp_s=-1), r"^ramp_s must be .*, got -1$"),
+    (lambda: impulse(0.03, fs=None), r"^fs must be a real number, got NoneType$"),
+    (lambda: impulse(0.03, pad_s=-1), r"^pad_s must be .*, got -1$"),
+])
+def test_a_waveform_names_the_argument_it_refuses(make, message):
+    with pytest.raises((ValueError, TypeError), match=message.replace("-1$", r"-1(\.0)?$")):
+        make()
+
+
+def test_a_stimulus_too_long_or_too_wide_for_memory_is_refused_before_it_is_built(monkeypatch):
+    monkeypatch.setenv("DDMM_MEMORY_LIMIT", "200M")
+    with pytest.raises(ValueError, match=r"an indentation of 2000.1 s at 5000 Hz would need about .*MEMORY_LIMIT"):
+        ramp_hold(0.5, hold_s=2000.0)
+    with pytest.raises(ValueError, match=r"an indentation of 10500 samples x 1264 pins would need about"):
+        indent(circle_pins(), ramp_hold(0.5, hold_s=2.0), fs=FS)
+    with pytest.raises(ValueError, match=r"a bar of 1.0 x 0.5 mm at pins_per_mm=1000 would take about 500000 pins, "
+                                         r"more than the 4000 allowed; use a lower pins_per_mm or a smaller bar"):
+        bar_pins(pins_per_mm=1000)
+    with pytest.raises(ValueError, match=r"a disc of radius 15 mm at pins_per_mm=10.0 would take about 70686 pins"):
+        circle_pins(15)
 
 
 def test_a_pin_off_the_skin_is_refused(fingertip):
@@ -152,6 +197,32 @@ def test_ddmm_simulate_runs_an_indentation_and_refuses_a_bad_one(tmp_path):
     off = subprocess.run(run + ["--indent", "ramp:depth_mm=0.3,x_mm=40", "--out", str(tmp_path / "d.nc")],
                          capture_output=True, text=True)
     assert off.returncode == 2 and "off the skin" in off.stderr and len(off.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(("extra", "toml", "message"), [
+    (["--scene", "birznieks"], None, r"give either --indent or --scene, not both \(--scene 'birznieks'\)"),
+    (["--fs", "1000"], None, (r"--fs reads a recorded --scene and does not apply to an --indent stimulus: set its "
+                              r"rate as --indent \.\.\.,fs=HZ")),
+    (["--sensor-noise", "0.1"], None, r"--sensor-noise reads a recorded --scene and does not apply to an --indent"),
+    (["--indent", "ramp:depth_mm=0.5,pins=bar,pins_per_mm=1000"], None,
+     r"a bar of .* would take about 500000 pins, more than the 4000 allowed; use a lower pins_per_mm"),
+    (["--indent", "ramp:depth_mm=0.5,pins=circle,disc_radius_mm=15"], None, r"a disc of radius 15.0 mm .* smaller "),
+    (["--indent", "ramp:depth_mm=0.5,pins=circle,disc_radius_mm=-1"], None, r"disc_radius_mm must be .* got -1.0"),
+    (["--indent", "ramp:depth_mm=0.5,hold_s=0.1,depth_mm=0.3"], None, r"--indent key 'depth_mm' is given twice"),
+    ([], '[pins]\nkind = "bar"\n', r"indent key 'pins' must be text, got a table"),
+    ([], "kind = [1]\n", r"indent key 'kind' must be text, got a list"),
+    ([], 'kind = "ramp"\ndepth_mm = 0.5\nhold_s = [0.1]\n', r"indent key 'hold_s' must be a number, got a list"),
+])
+def test_ddmm_simulate_refuses_a_conflicting_or_oversized_indentation_in_one_line(tmp_path, capsys, extra, toml,
+                                                                                 message):
+    from ddmm.experiments.cli import main
+
+    if toml is not None:
+        (tmp_path / "in.toml").write_text(toml)
+    indent_arg = ["--indent", str(tmp_path / "in.toml") if toml is not None else "ramp:depth_mm=0.5,hold_s=0.1"]
+    code = main(["simulate", "--quiet", "--engine", "direct", "--out", str(tmp_path / "o.nc"), *indent_arg, *extra])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1 and re.search(message, err), err
 
 
 def test_the_spread_is_the_stress_at_each_types_depth_times_the_reference_area():

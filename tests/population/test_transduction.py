@@ -32,10 +32,20 @@ def test_the_lead_lag_has_unit_gain_at_rest_and_its_corners_ratio_above_them():
     ({"gain": 0.0}, "gain"), ({"gain": float("nan")}, "gain"), ({"gain": True}, "gain"),
     ({"zero_hz": 5.0}, "both"), ({"zero_hz": -1.0, "pole_hz": 5.0}, "zero_hz"),
     ({"zero_hz": 5.0, "pole_hz": float("inf")}, "pole_hz"),
+    ({"gain": np.bool_(True)}, "gain"), ({"gain": "0.3"}, "gain"), ({"gain": np.float32("nan")}, "gain"),
+    ({"gain": np.float64("inf")}, "gain"), ({"gain": np.int64(0)}, r"gain must be a finite number > 0, got 0$"),
+    ({"gain": -np.float32(0.5)}, r"gain .* got -0.5$"), ({"zero_hz": np.int64(-1), "pole_hz": 5.0}, "zero_hz"),
 ])
 def test_a_bad_transduction_is_refused_naming_the_field(kwargs, match):
     with pytest.raises(ValueError, match=match):
         Transduction(**kwargs)
+
+
+@pytest.mark.parametrize("value", [np.float32(0.3), np.int64(1), np.float64(2.5), np.int32(7), 4])
+def test_numpy_scalars_are_accepted_and_kept_as_plain_floats(value):
+    t = Transduction(gain=value, zero_hz=value, pole_hz=np.float32(1000.0))
+    assert [type(v) for v in (t.gain, t.zero_hz, t.pole_hz)] == [float, float, float]
+    assert t.gain == pytest.approx(float(value)) and t.sections(5000.0).shape == (1, 6)
 
 
 def test_transduction_sets_by_name_or_mapping():
