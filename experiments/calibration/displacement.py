@@ -1,4 +1,4 @@
-"""Fit each type's transduction from stress to drive to TouchSim's responses on half of a named list.
+"""Fit each type's transduction from stress to drive to TouchSim's responses on part of a named list.
 
 What is fitted (per type, SA-I, FA-I and FA-II against TouchSim's SA1, RA and PC): the three numbers of
 `ddmm.population.stimuli.transduction.Transduction` (gain, and the lead-lag's zero and pole, each within
@@ -13,10 +13,10 @@ populations and seeds.  One caveat on the split: a first fit on the 0.5 mm ramp 
 under the signatures' pressed grating (FA-I's spatial modulation then had nothing to measure); the ramps
 at 0.25 and 1 mm joined the fitted cells after that, so FA-I's spatial modulation informed the split.
 
-The units are the nearest of each type of five fingertips (the preset sampled with `FIT_SEEDS`), as many
+The units are the nearest of each type of ten fingertips (the preset sampled with `FIT_SEEDS`), as many
 per fingertip as TouchSim has single models, all at the probe (`touchsim_side_by_side.named_units`): their
 mean rate is the fit's, so the transduction fits the population's typical unit, not four units' quirks.
-Every evaluation uses the same noise seed, so the objective is deterministic.  Five more fingertips
+Every evaluation uses the same noise seed, so the objective is deterministic.  Ten more fingertips
 (`HELD_OUT_SEEDS`) are held out: on them every cell is a prediction.
 
 Run::

@@ -1,7 +1,8 @@
 """The classic signatures of tactile afferents on displacement input, all held out from the transduction fit.
 
-Each runs the fingertip preset on seeds the fit never used (it used seed 0's nearest units), through
-`indent` with the shipped ``"fitted"`` transduction and the default skin.  In 1-3 the 10 units of each type
+Each runs the fingertip preset (seeds 1-4 by default) through `indent` with the shipped ``"fitted"``
+transduction and the default skin, on protocols the fit never saw; the fit's units were the few nearest of
+each type of seeds 0-9, so some units here were among them (``--seed 11`` runs on fingertips it never saw).  In 1-3 the 10 units of each type
 nearest the fingertip's centre are moved under the probe (its hotspot on each unit, as in
 microneurography):
 
@@ -238,10 +239,12 @@ def _finest(modulation, criterion: float = 0.3):
 def main(argv=None) -> int:
     """Run the five signatures and print each, labelled held out, with its target (module docstring)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seed", type=int, default=1, help="population and noise seed (the fit used 0)")
+    parser.add_argument("--seed", type=int, default=1, help="population and noise seed (the fit's units: the "
+                        "nearest of seeds 0-9; 10 and above: fingertips it never saw)")
     s = parser.parse_args(argv).seed
-    print("displacement signatures, all HELD OUT (no fit saw these protocols or seeds); fingertip seeds "
-          f"{s}, {s + 1}, {s + 2}")
+    seen = "some of their units were in the fit" if s <= 9 else "fingertips the fit never saw"
+    print(f"displacement signatures, HELD OUT protocols (no fit saw them); fingertip seeds {s}, {s + 1}, {s + 2} "
+          f"({seen})")
     curves = threshold_curves(s)
     for kind in _TYPES:
         c = curves[kind]

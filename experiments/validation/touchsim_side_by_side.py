@@ -2,11 +2,12 @@
 
 The named list (issue 43): a ramp-and-hold on one 1 mm probe at 0.25, 0.5 and 1.0 mm; sinusoids on the
 probe at 5-300 Hz and 0.01, 0.05 and 0.2 mm on a 0.3 mm pre-indentation; a 1 mm grating scanned at 40 mm/s
-(`grating_scene`).  ddmm's units are the nearest units of each type of five fingertips (the preset sampled
-with five seeds: by default `HELD_OUT_SEEDS`, which the transduction fit never saw), moved to the probe's
+(`grating_scene`).  ddmm's units are the nearest units of each type of ten fingertips (the preset sampled
+with ten seeds: by default `HELD_OUT_SEEDS`, which the transduction fit never saw), moved to the probe's
 centre (their own gains, sensitivities and noise), on the default skin; TouchSim's are its single models at
-the same place; ddmm reads the stress through its shipped transduction (``"fitted"``: fitted on half of
-these cells with the units of `FIT_SEEDS`, `ddmm.experiments.calibration.displacement`).  TouchSim's figures come from its own run
+the same place; ddmm reads the stress through its shipped transduction (``"fitted"``: fitted on part of
+these cells with the units of `FIT_SEEDS`, `ddmm.experiments.calibration.displacement`).  TouchSim's
+figures come from its own run
 (`experiments/validation/touchsim_responses.py`, in TouchSim's environment), recorded in a JSON file.
 
 Run::

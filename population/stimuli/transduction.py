@@ -18,7 +18,7 @@ named parameters (`Transduction`):
 
 The force path is untouched: only indentation scenes carry a transduction.
 Named sets (`TRANSDUCTIONS`): ``"fitted"`` (the default: SA-I, FA-I and FA-II
-fitted to TouchSim's responses on half of a named list of stimuli; SA-II,
+fitted to TouchSim's responses on part of a named list of stimuli; SA-II,
 which TouchSim does not model, unit gain and no filter) and ``"none"`` (unit
 gain and no filter for every type: the mechanics straight into the force
 path).  The fit, its split and what it holds out: docs/model.md,

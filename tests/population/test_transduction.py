@@ -1,5 +1,5 @@
 """Transduction of indentation (`ddmm.population.stimuli.transduction`) and the displacement signatures it
-is held to (`ddmm.experiments.validation.displacement_signatures`, held out from the fit)."""
+is held to (`ddmm.experiments.validation.displacement_signatures`: protocols held out from the fit)."""
 
 import dataclasses
 
@@ -108,7 +108,8 @@ def test_the_force_path_carries_no_transduction():
     assert input_sections(Sites([0.0], [0.0], 1.0), FS) is None
 
 
-# The signatures: every one held out from the fit (other seeds, other protocols).
+# The signatures: protocols held out from the fit, on fingertip seeds 1-4 (some of whose nearest units were
+# among the fit's; on seeds 11-13 FA-II's best frequency and FA-I's resolution fail: docs/validation.md).
 
 @pytest.fixture(scope="module")
 def curves():
