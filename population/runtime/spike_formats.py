@@ -90,20 +90,11 @@ def _frames(ids, bits, stamps, capacity):
     """Frames of (ids, stamps) spikes: groups of equal stamps (``bits``: the stamps' binary64 bits), split
     across frames when full; int32 (n_frames, capacity) padded with -1, and each frame's first stamp."""
     n = ids.size
-    n_frames, pos = 1, 0  # a first pass counts the frames
-    i = 0
-    while i < n:
-        j = i + 1
-        while j < n and bits[j] == bits[i]:
-            j += 1
-        while i < j:
-            if capacity - pos < 4:
-                n_frames, pos = n_frames + 1, 0
-            m = min(j - i, capacity - pos - 3)
-            pos, i = pos + 3 + m, i + m
-    out = np.full((n_frames, capacity), -1, np.int32)
-    first = np.empty(n_frames)
-    f, pos, i = 0, 0, 0
+    # One walk lays the pieces out (a piece: a group's spikes that fit in one frame; at most one a spike),
+    # then the frames are filled from the layout.
+    start, count = np.empty(n, np.int64), np.empty(n, np.int64)
+    frame, where = np.empty(n, np.int64), np.empty(n, np.int64)
+    pieces, f, pos, i = 0, 0, 0, 0
     while i < n:
         j = i + 1
         while j < n and bits[j] == bits[i]:
@@ -111,15 +102,20 @@ def _frames(ids, bits, stamps, capacity):
         while i < j:
             if capacity - pos < 4:
                 f, pos = f + 1, 0
-            if pos == 0:
-                first[f] = stamps[i]
             m = min(j - i, capacity - pos - 3)
-            out[f, pos] = m
-            out[f, pos + 1] = np.int32(bits[i] >> 32)
-            out[f, pos + 2] = np.int32(bits[i] & 0xFFFFFFFF)
-            for k in range(m):
-                out[f, pos + 3 + k] = ids[i + k]
-            pos, i = pos + 3 + m, i + m
+            start[pieces], count[pieces], frame[pieces], where[pieces] = i, m, f, pos
+            pieces, pos, i = pieces + 1, pos + 3 + m, i + m
+    out = np.full((f + 1, capacity), -1, np.int32)
+    first = np.empty(f + 1)
+    for p in range(pieces):
+        i, m, f, pos = start[p], count[p], frame[p], where[p]
+        if pos == 0:
+            first[f] = stamps[i]
+        out[f, pos] = m
+        out[f, pos + 1] = np.int32(bits[i] >> 32)
+        out[f, pos + 2] = np.int32(bits[i] & 0xFFFFFFFF)
+        for k in range(m):
+            out[f, pos + 3 + k] = ids[i + k]
     return out, first
 
 

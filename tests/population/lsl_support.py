@@ -1,5 +1,7 @@
 """What the LSL, spike-format and XDF tests share: unique stream names, a spike sink, and a recorded press."""
 
+import threading
+import time
 import uuid
 
 import numpy as np
@@ -28,6 +30,18 @@ class Collect:
     def arrays(self):
         return (np.concatenate(self.positions or [np.empty(0, int)]),
                 np.concatenate(self.stamps or [np.empty(0)]))
+
+
+def start_bridge(bridge, n_samples, outlet, timeout=20.0):
+    """Run ``bridge`` over ``n_samples`` samples at FS in a thread (stopped after ``timeout`` s at the latest)
+    and wait until it has subscribed to ``outlet``: (the thread, its deadline on `time.monotonic`)."""
+    deadline = time.monotonic() + timeout
+    worker = threading.Thread(target=bridge.run, kwargs={"duration": n_samples / FS,
+                                                         "should_stop": lambda: time.monotonic() > deadline})
+    worker.start()
+    while not outlet.have_consumers() and time.monotonic() < deadline:  # the bridge opens the inlet
+        time.sleep(0.01)
+    return worker, deadline
 
 
 def plate_recording(tmp_path_factory):

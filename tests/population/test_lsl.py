@@ -4,7 +4,6 @@ Loopback only (tests/conftest.py writes the LSL config and sets LSLAPICFG);
 every stream name is unique to its test, every wait is bounded.
 """
 
-import threading
 import time
 
 import numpy as np
@@ -17,7 +16,7 @@ from ddmm.population.runtime.lsl_outlets import SpikeOutlet, read_spike_metadata
 from ddmm.population.runtime.lsl_bridge import Bridge, check_stamps
 from ddmm.population.runtime.stream import Encoder
 
-from .lsl_support import DT, FS, Collect, plate_recording
+from .lsl_support import DT, FS, Collect, plate_recording, start_bridge
 from .lsl_support import unique_name as _name
 
 
@@ -195,12 +194,7 @@ def test_spikes_over_lsl_equal_the_offline_run_of_the_recorded_scene(recording):
     assert list(meta["afferents"]["type"]) == list(pop.afferent_type[encoder.positions])
     assert meta["input"]["name"] == names[0] and meta["model"]["seed"] == "4"
     bridge = Bridge(encoder, force, spikes.push)
-    deadline = time.monotonic() + 20.0
-    worker = threading.Thread(target=bridge.run, kwargs={"duration": raw.shape[0] / FS,
-                                                         "should_stop": lambda: time.monotonic() > deadline})
-    worker.start()
-    while not outlet.have_consumers() and time.monotonic() < deadline:  # the bridge opens the inlet
-        time.sleep(0.01)
+    worker, _ = start_bridge(bridge, raw.shape[0], outlet)
     t0 = pylsl.local_clock()
     rng = np.random.default_rng(1)
     edges = np.unique(np.r_[0, rng.integers(1, raw.shape[0], 60), raw.shape[0]])
@@ -273,12 +267,7 @@ def test_stimulation_pulses_over_lsl_equal_the_offline_stimulation_encoder(recor
     spikes, pulses = SpikeOutlet(names[1], stimulator.encoder, force=force), PulseOutlet(names[2], stimulator)
     inlet, _ = _spike_inlet(names[2])
     bridge = Bridge(stimulator.encoder, force, spikes.push, stimulator=stimulator, pulse_sink=pulses.push)
-    deadline = time.monotonic() + 20.0
-    worker = threading.Thread(target=bridge.run, kwargs={"duration": raw.shape[0] / FS,
-                                                         "should_stop": lambda: time.monotonic() > deadline})
-    worker.start()
-    while not outlet.have_consumers() and time.monotonic() < deadline:
-        time.sleep(0.01)
+    worker, deadline = start_bridge(bridge, raw.shape[0], outlet)
     t0 = pylsl.local_clock()
     for a in range(0, raw.shape[0], 50):
         outlet.push_chunk(raw[a:a + 50], (t0 + np.arange(a, min(a + 50, raw.shape[0])) / FS).tolist())

@@ -5,7 +5,6 @@ Loopback only (tests/conftest.py writes the LSL config); every stream name is un
 
 import subprocess
 import sys
-import threading
 import time
 from itertools import pairwise
 
@@ -20,7 +19,7 @@ from ddmm.population.runtime.lsl_outlets import SpikeOutlet, read_spike_metadata
 from ddmm.population.runtime.spike_formats import FRAME_CAPACITY, SPIKE_FORMATS, _frames, _jit, decode_spikes
 from ddmm.population.runtime.stream import Encoder
 
-from .lsl_support import DT, FS, plate_recording
+from .lsl_support import DT, FS, plate_recording, start_bridge
 from .lsl_support import unique_name as _name
 
 
@@ -146,12 +145,7 @@ def test_batched_spikes_over_lsl_equal_the_offline_run_and_the_events_stamps(rec
         events.push(positions, stamps)
         batched.push(positions, stamps)
     bridge = Bridge(encoder, force, both)
-    deadline = time.monotonic() + 20.0
-    worker = threading.Thread(target=bridge.run, kwargs={"duration": raw.shape[0] / FS,
-                                                         "should_stop": lambda: time.monotonic() > deadline})
-    worker.start()
-    while not outlet.have_consumers() and time.monotonic() < deadline:
-        time.sleep(0.01)
+    worker, _ = start_bridge(bridge, raw.shape[0], outlet)
     t0 = pylsl.local_clock()
     rng = np.random.default_rng(1)
     edges = np.unique(np.r_[0, rng.integers(1, raw.shape[0], 60), raw.shape[0]])
