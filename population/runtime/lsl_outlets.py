@@ -28,14 +28,27 @@ from __future__ import annotations
 
 import ctypes
 import hashlib
+import time
 
 import numpy as np
 
 from ddmm.population.runtime.lsl import PULSE_STREAM_TYPE, SPIKE_STREAM_TYPE, ForceStream, _handle_error, _pylsl
 from ddmm.population.runtime.spike_formats import SPIKE_FORMATS, decode_spikes
-from ddmm.utils.validation import check_instance
+from ddmm.utils.validation import check_instance, check_nonnegative
 
-__all__ = ["PulseOutlet", "SpikeOutlet", "decode_spikes", "read_spike_metadata"]
+__all__ = ["CLOSE_LINGER_S", "PulseOutlet", "SpikeOutlet", "decode_spikes", "read_spike_metadata"]
+
+#: How long (s) a closing outlet with consumers stays open first.  liblsl drops the samples it has queued
+#: but not yet sent when an outlet is destroyed, so a run that ends at once (``--duration``) could lose its
+#: last spikes on a loaded host; one second lets the transfer threads send them.
+CLOSE_LINGER_S = 1.0
+
+
+def _withdraw(outlet, linger) -> None:
+    """Destroy a pylsl outlet after ``linger`` seconds if an inlet is connected to it."""
+    linger = check_nonnegative(linger, "linger", "s")
+    if linger and outlet.have_consumers():
+        time.sleep(linger)
 
 
 def _text(values, fmt=str) -> str:
@@ -118,8 +131,12 @@ class SpikeOutlet:
         """Whether any inlet is connected."""
         return bool(self._outlet.have_consumers())
 
-    def close(self) -> None:
-        """Withdraw the stream (consumers see it end)."""
+    def close(self, linger: float = CLOSE_LINGER_S) -> None:
+        """Withdraw the stream (consumers see it end), after ``linger`` seconds if any is connected.
+
+        The wait lets liblsl send what it has queued: it drops those samples when an outlet is destroyed.
+        """
+        _withdraw(self._outlet, linger)
         self._push_n = None  # holds the outlet's handle, which dies with it
         del self._outlet
 
@@ -172,8 +189,9 @@ class PulseOutlet:
             rows = np.column_stack([np.asarray(electrode, float), amplitude_ua, phase_width_us])
             self._outlet.push_chunk(rows, np.asarray(stamps, float).tolist())
 
-    def close(self) -> None:
-        """Withdraw the stream."""
+    def close(self, linger: float = CLOSE_LINGER_S) -> None:
+        """Withdraw the stream, after ``linger`` seconds if a consumer is connected (see `SpikeOutlet.close`)."""
+        _withdraw(self._outlet, linger)
         del self._outlet
 
 

@@ -186,6 +186,29 @@ def test_an_outlet_push_over_a_frame_arrives_whole(recording):
         SpikeOutlet(_name("bad"), encoder, spike_format="Batched")
 
 
+def test_closing_an_outlet_waits_for_its_consumers_and_delivers_the_last_spikes(recording):
+    """close() right after a push stays open `linger` seconds while an inlet is connected (liblsl drops what
+    it has queued but not sent when an outlet dies); with nobody connected it returns at once."""
+    pop = recording[0]
+    encoder = Encoder(pop, FS, seed=4)
+    outlet = SpikeOutlet(_name("linger"), encoder)
+    inlet, _ = _spike_inlet(outlet.name)
+    positions = np.random.default_rng(5).integers(0, len(pop), 200000)
+    stamps = 100.0 + np.arange(positions.size) * 1e-5
+    outlet.push(positions, stamps)
+    start = time.monotonic()
+    outlet.close(linger=1.0)
+    assert time.monotonic() - start >= 1.0
+    samples, got = _drain(inlet, lambda: True)
+    np.testing.assert_array_equal(decode_spikes(samples, got, "events")[0], pop.afferent_id[positions])
+    alone = SpikeOutlet(_name("alone"), encoder)
+    start = time.monotonic()
+    alone.close(linger=30.0)
+    assert time.monotonic() - start < 30.0
+    with pytest.raises(ValueError, match="linger must be a finite number >= 0 s, got -1"):
+        SpikeOutlet(_name("bad"), encoder).close(linger=-1.0)
+
+
 @pytest.mark.parametrize("argv, message", [
     (["--lsl-spike-format", "frames"], ("argument --lsl-spike-format: invalid choice: 'frames' (choose from "
                                         "'events', 'batched')")),
