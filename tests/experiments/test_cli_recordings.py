@@ -159,7 +159,8 @@ def test_other_libraries_warnings_stay_quiet_unless_debugging(monkeypatch, capsy
 
 
 def test_a_brian2_run_prints_no_warning(tmp_path):
-    """The default engine, in a fresh process as a user runs it: nothing on stderr."""
+    """The default engine, in a fresh process as a user runs it: nothing on stderr but, on a cold cache, the
+    one-line notice that it compiles."""
     import os
     import subprocess
     import sys
@@ -167,4 +168,5 @@ def test_a_brian2_run_prints_no_warning(tmp_path):
     done = subprocess.run([sys.executable, "-m", "ddmm.experiments.cli", "simulate", "--population", "fingertip",
                            "--engine", "brian2", "--quiet", "--out", str(tmp_path / "o.nc")],
                           capture_output=True, text=True, timeout=600, env={**os.environ, "DDMM_PROGRESS": "0"})
-    assert done.returncode == 0 and done.stderr == "", done.stderr
+    lines = [line for line in done.stderr.splitlines() if not line.startswith("ddmm: compiling the Brian2 engine")]
+    assert done.returncode == 0 and lines == [] and done.stderr.count("\n") <= 1, done.stderr

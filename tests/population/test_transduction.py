@@ -108,8 +108,31 @@ def test_the_force_path_carries_no_transduction():
     assert input_sections(Sites([0.0], [0.0], 1.0), FS) is None
 
 
-# The signatures: protocols held out from the fit, on fingertip seeds 1-4 (some of whose nearest units were
-# among the fit's; on seeds 11-13 FA-II's best frequency and FA-I's resolution fail: docs/validation.md).
+# The signatures: protocols held out from the fit, on units pooled over four fingertips from seed 1, 2 or 3
+# (some of whose nearest units were among the fit's; docs/validation.md gives six groups of fingertips the
+# fit never saw, on half of which FA-I resolve 2 mm gratings as SA-I do).
+
+def test_one_spike_per_cycle_is_judged_cycle_by_cycle():
+    """A unit locked 1:1 that skips one cycle in 120 is at threshold; one firing two spikes in every other
+    cycle is not, though its count equals the cycles'."""
+    import xarray as xr
+
+    from ddmm.experiments.validation.displacement_signatures import AMPLITUDES_MM, FREQUENCIES_HZ, _thresholds
+
+    f = FREQUENCIES_HZ.index(300.0)
+    cycles = 0.1 + (np.arange(120) + 0.25) / 300.0  # the window's 120 cycles of 300 Hz, a spike a quarter in
+    skipping = np.delete(cycles, 7)
+    doubled = np.concatenate([cycles[::2], cycles[::2] + 0.5 / 300.0])
+    times = [skipping, doubled, cycles]  # unit 0 at amplitude 0; unit 1 at amplitude 0, then 1:1 at 1
+    cond = np.concatenate([np.full(skipping.size, 2 * f), np.full(doubled.size, 2 * f),
+                           np.full(cycles.size, 2 * f + 1)])
+    aff = np.concatenate([np.zeros(skipping.size, int), np.ones(doubled.size, int), np.ones(cycles.size, int)])
+    ds = xr.Dataset({"spike_time": ("spike", np.concatenate(times)), "spike_condition": ("spike", cond),
+                     "spike_afferent": ("spike", aff)}, coords={"afferent": [0, 1]})
+    th = _thresholds(ds, 2, np.zeros(2))
+    assert th[f].tolist() == [AMPLITUDES_MM[0], AMPLITUDES_MM[1]]
+    assert np.isnan(th[:f]).all() and np.isnan(th[f + 1:]).all()
+
 
 @pytest.fixture(scope="module")
 def curves():
