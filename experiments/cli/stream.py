@@ -37,6 +37,7 @@ LSL force stream in real time: a synthetic sensor for trying ``--lsl-in``.
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 from contextlib import contextmanager
@@ -75,6 +76,10 @@ def register(sub) -> None:
     p.add_argument("--model-fs", type=float, default=1000.0, metavar="HZ",
                    help="the model's sample rate after conditioning (default 1000, as ddmm simulate's files)")
     p.add_argument("--duration", type=float, default=None, metavar="S", help="stop after S seconds of input")
+    p.add_argument("--threads", type=int, default=None, metavar="N",
+                   help="threads a push runs on (default: DDMM_NUM_THREADS if set; else one with --lsl-in on a "
+                        "host of at most two cores, where the sender and the consumers need the other; else every "
+                        "core)")
     g = p.add_argument_group("Lab Streaming Layer (extra ddmm[lsl])")
     g.add_argument("--lsl-in", default=None, metavar="NAME", help="read forces from the LSL stream of this name")
     g.add_argument("--lsl-source-id", default=None, metavar="ID", help="pick one of several streams of that name")
@@ -200,7 +205,19 @@ def _encoder(args, fs, sites):
                    engine=args.engine, seed=args.seed, afferent_types=parse_types(args.types),
                    contact=parse_contact(args.contact),
                    sites=sites, conditioning=conditioning, model_fs=None if conditioning is None else args.model_fs,
-                   max_force_n=args.max_force)
+                   max_force_n=args.max_force, threads=encoder_threads(args.threads, live=args.lsl_in is not None))
+
+
+def encoder_threads(threads, *, live: bool):
+    """The encoder's threads for ``--threads`` (None: the default).  A parallel push waits at its end for
+    every thread, and on a 2-core host a live sender and the spikes' consumers take a core from it now and
+    then: measured with the whole hand over LSL, one thread gave a p99 of 0.68-0.81 ms, two 0.85-3.9 ms
+    (docs/live-sensors.md)."""
+    if threads is not None:
+        return threads
+    if live and not os.environ.get("DDMM_NUM_THREADS") and (os.cpu_count() or 1) <= 2:
+        return 1
+    return None
 
 
 def run(args) -> int:
@@ -210,6 +227,8 @@ def run(args) -> int:
         raise ValueError("--conditioning zero_phase looks ahead: a stream is causal or off")
     if args.duration is not None and not args.duration > 0:
         raise ValueError(f"--duration must be > 0 s, got {args.duration:g}")
+    if args.threads is not None and args.threads < 1:
+        raise ValueError(f"--threads must be >= 1, got {args.threads}")
     if args.lsl_in is None and (args.lsl_source_id is not None):
         raise ValueError("--lsl-source-id goes with --lsl-in")
     if args.lsl_out is None and args.lsl_spike_format is not None:

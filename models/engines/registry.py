@@ -51,8 +51,9 @@ class Engine:
     def prepare(self) -> None:
         """Import the engine's heavy modules now, in the calling (main) thread."""
 
-    def stream_parts(self, n_afferents: int) -> int:
-        """Column ranges a streaming push integrates in parallel (1: serial)."""
+    def stream_parts(self, n_afferents: int, threads: int | None = None) -> int:
+        """Column ranges a streaming push integrates in parallel (1: serial); ``threads`` caps them (None: the
+        engine's default)."""
         return 1
 
     def run(self, current, substeps, dt, params, v, u, r, *, method, v_peak, v_floor):
@@ -137,10 +138,11 @@ class DirectEngine(Engine):
     def prepare(self) -> None:
         from . import direct  # noqa: F401 - loads numba and the kernels
 
-    def stream_parts(self, n_afferents: int) -> int:
+    def stream_parts(self, n_afferents: int, threads: int | None = None) -> int:
         from .direct import default_threads
 
-        return default_threads() if n_afferents >= self.parallel_min_afferents else 1
+        threads = default_threads() if threads is None else threads
+        return threads if n_afferents >= self.parallel_min_afferents else 1
 
     def run(self, current, substeps, dt, params, v, u, r, *, method, v_peak, v_floor):
         from .direct import run_direct

@@ -34,7 +34,7 @@ from ddmm.population.stimuli.conditioning import Conditioner, Conditioning, nois
 from ddmm.population.stimuli.recordings import MAX_FORCE_N, RECORDED, check_force_bound
 from ddmm.population.stimuli.scenes import DEFAULT_FS, MAX_FS, Contact, Sites
 from ddmm.utils.deprecation import renamed_keyword
-from ddmm.utils.validation import as_finite_array, check_choice, check_positive
+from ddmm.utils.validation import as_finite_array, check_choice, check_count, check_positive
 
 __all__ = ["StreamSpikes", "Encoder"]
 
@@ -103,11 +103,15 @@ class Encoder:
         The largest force (N, magnitude) a pushed sample may carry at a site,
         1 kN by default: a chunk beyond it is refused (a unit slip).
 
+    threads : int, optional
+        The most threads a push runs on (None: ``DDMM_NUM_THREADS``, else
+        every core).  One keeps a push off the cores a live sender and its
+        consumers need (`ddmm stream --lsl-in` on a 2-core host).
+
     Notes
     -----
     From ``DirectEngine.parallel_min_afferents`` afferents, the direct engine's pushes run
-    on ``DDMM_NUM_THREADS`` numba threads (default: every core), read when
-    the encoder is made; ``DDMM_NUM_THREADS=1`` keeps a push on one core.
+    on ``threads`` numba threads, read when the encoder is made; no spike changes with it.
 
     Examples
     --------
@@ -122,13 +126,14 @@ class Encoder:
     def __init__(self, population, fs: float, *, dt: float = 1e-4, engine: str = "direct", method: str = "euler",
                  seed=None, no_shear: str = "smooth", contact: Contact | None = None, sites: Sites | None = None,
                  afferent_types=None, conditioning: Conditioning | None = RECORDED, model_fs: float | None = None,
-                 max_force_n: float = MAX_FORCE_N):
+                 max_force_n: float = MAX_FORCE_N, threads: int | None = None):
         if not isinstance(population, Population):
             raise TypeError(f"population must be a Population, got {type(population).__name__}")
         self.fs = check_positive(fs, "fs", "Hz")
         if self.fs > MAX_FS:
             raise ValueError(f"fs = {self.fs:g} Hz is beyond any force sensor (at most {MAX_FS:g} Hz)")
         self.max_force_n = check_positive(max_force_n, "max_force_n", "N")
+        self._threads = None if threads is None else check_count(threads, "threads")
         self.conditioning = conditioning
         self.model_fs = self._model_fs(conditioning, model_fs)
         self.substeps = substeps_for(self.model_fs, dt)
@@ -169,7 +174,7 @@ class Encoder:
         # refuse a chunk after it ran: theirs write spare buffers, committed when the chunk succeeds.
         self._in_place = self.method == "euler"
         # Read once: a push is latency-bound, and the thread count is fixed for the encoder's life.
-        self._parts = self._engine.stream_parts(len(pop))
+        self._parts = self._engine.stream_parts(len(pop), self._threads)
         noisy = np.any(pop.noise_sigma > 0) or np.any(pop.noise_cv > 0) or self._pipeline.excite_any
         self._key = noise_key(self.seed, 0, 0) if noisy else None
         # The neurons before the first sample (SA-II's phases drawn): made once, copied at each reset.

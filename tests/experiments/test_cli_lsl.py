@@ -132,6 +132,7 @@ def test_the_docs_two_process_example_runs():
     (["--lsl-in", "X", "--sites", "fingertips", "--resolve-timeout", "1"], "no LSL stream named 'X'"),
     (["--lsl-source-id", "abc", "--fs", "100"], "--lsl-source-id goes with --lsl-in"),
     ([], "--fs is required when the input is standard input"),
+    (["--threads", "0", "--fs", "100"], "--threads must be >= 1, got 0"),
 ])
 def test_stream_errors_are_one_line(argv, message, capsys):
     from ddmm.experiments.cli import main
@@ -154,6 +155,22 @@ def test_a_stream_of_the_wrong_width_and_a_missing_extra(capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "pylsl", None)
     assert main(["stream", "--lsl-in", name, "--resolve-timeout", "1"]) == 2
     assert 'open_force_stream needs pylsl: pip install "ddmm[lsl]"' in capsys.readouterr().err
+
+
+def test_a_live_stream_on_two_cores_pushes_on_one_thread(monkeypatch):
+    """--threads' default: one with --lsl-in on a host of at most two cores (unless DDMM_NUM_THREADS is set),
+    else the encoder's own default (None); a given count is kept."""
+    from ddmm.experiments.cli.stream import encoder_threads
+
+    monkeypatch.delenv("DDMM_NUM_THREADS", raising=False)
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    assert encoder_threads(None, live=True) == 1 and encoder_threads(None, live=False) is None
+    assert encoder_threads(3, live=True) == 3
+    monkeypatch.setenv("DDMM_NUM_THREADS", "2")
+    assert encoder_threads(None, live=True) is None
+    monkeypatch.delenv("DDMM_NUM_THREADS")
+    monkeypatch.setattr(os, "cpu_count", lambda: 8)
+    assert encoder_threads(None, live=True) is None
 
 
 def test_the_bench_latency_is_per_sample_until_its_last_spike():

@@ -51,6 +51,26 @@ def test_parallel_push_equals_offline(setup, monkeypatch, threads):
     np.testing.assert_array_equal(t, offline["direct"].spike_time.values)
 
 
+def test_the_threads_argument_caps_a_push_and_changes_no_spike(setup, monkeypatch):
+    """Encoder(threads=1) pushes in one part whatever DDMM_NUM_THREADS says, threads=2 in two: the same
+    spikes; a count below 1 or not an integer is refused."""
+    from ddmm.models.engines import get_engine
+
+    monkeypatch.setattr(get_engine("direct"), "parallel_min_afferents", 1)
+    monkeypatch.setenv("DDMM_NUM_THREADS", "3")
+    pop, forces, offline = setup
+    for threads in (1, 2):
+        enc = Encoder(pop, 1000.0, engine="direct", seed=3, conditioning=None, threads=threads)
+        assert enc._parts == threads
+        aff, t = concat([enc.push(forces[a:a + 7]) for a in range(0, N, 7)])
+        np.testing.assert_array_equal(aff, offline["direct"].spike_afferent.values)
+        np.testing.assert_array_equal(t, offline["direct"].spike_time.values)
+    with pytest.raises(ValueError, match="threads must be an integer >= 1, got 0"):
+        Encoder(pop, 1000.0, threads=0)
+    with pytest.raises(TypeError, match="threads must be an integer, got float 1.5"):
+        Encoder(pop, 1000.0, threads=1.5)
+
+
 def test_bad_chunks_do_not_corrupt_the_state(setup):
     pop, forces, offline = setup
     enc = Encoder(pop, 1000.0, engine="direct", seed=3, conditioning=None)
