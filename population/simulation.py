@@ -449,7 +449,7 @@ def _compile_notice(quiet: bool) -> None:
 
     where = os.environ.get("NUMBA_CACHE_DIR")
     cache = Path(where) if where else Path(fused.__file__).parent / "__pycache__"
-    if not any(cache.rglob("fused.*.nbi")):
+    if not any(cache.rglob("_fused_passes.*.nbi")):  # the fused pipeline's kernels, beside fused.py
         print(f"ddmm: compiling the numba kernels (first run only, about 20 s; cached in {cache})",
               file=sys.stderr, flush=True)
 

@@ -2,7 +2,7 @@
 
 `DirectEngine.advance` runs a chunk here: the pipeline's front pass and
 transducers (`ddmm.models.fused.FusedPipeline.drive`), then
-`back_and_integrate`: the fused back pass (`ddmm.models.fused._back`:
+`back_and_integrate`: the fused back pass (`ddmm.models._fused_passes._back`:
 low-pass, bias, additive noise) and `ddmm.models.engines.direct.integrate_range`
 on the currents while they are in cache, with the seam's checks
 (`ddmm.models.engines.direct.spike_checks`).  A push that integrates on
@@ -34,14 +34,14 @@ from ddmm.models.engines.direct import (
     part_bounds,
     spike_checks,
 )
-from ddmm.models.fused import _back, _back_range
+from ddmm.models._fused_passes import _back, _back_range
 
 __all__ = ["advance_fused", "back_and_integrate", "pipeline_spikes", "push_fused"]
 
 
 @nb.njit(cache=True, nogil=True)
 def back_and_integrate(tables, state, noise, current, neuron_table, mem, integrate):
-    """`ddmm.models.fused._back`, then (if ``integrate``) the direct engine on the current.
+    """`ddmm.models._fused_passes._back`, then (if ``integrate``) the direct engine on the current.
 
     ``tables``, ``state`` and ``noise`` as `_back` takes them; ``neuron_table``
     is the `NeuronTable` and ``mem`` the `Membrane` (updated in place), all as

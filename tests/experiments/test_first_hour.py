@@ -54,7 +54,7 @@ def test_the_compile_notice_says_so_once_when_the_cache_is_empty(monkeypatch, tm
     err = capsys.readouterr().err
     assert err.count("compiling the numba kernels (first run only") == 1 and str(tmp_path) in err
     monkeypatch.setattr(simulation, "_NOTICED", [])
-    (tmp_path / "fused._back-1.py311.nbi").write_text("")
+    (tmp_path / "_fused_passes._back-1.py311.nbi").write_text("")
     simulation._compile_notice(quiet=False)
     assert capsys.readouterr().err == ""
 

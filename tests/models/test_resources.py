@@ -169,7 +169,7 @@ def test_plan_prints_the_memory_estimate_and_the_refusal(monkeypatch, capsys):
     _fake_room(monkeypatch, 1 << 30)
     assert main(["plan", "--population", "fingertip", "--trials", "10000", "--engine", "direct", "--quiet"]) == 0
     line = capsys.readouterr().out.splitlines()[-1]
-    assert re.fullmatch(r"memory: about 2\d\.\d GiB at peak \(.*, [\d,]+ spike events at 128 B from a pilot of "
+    assert re.fullmatch(r"memory: about 2\d(\.\d)? GiB at peak \(.*, [\d,]+ spike events at 128 B from a pilot of "
                         r"128 afferents\); this process may use 1 GiB more; simulate would refuse this run", line), line
 
 
