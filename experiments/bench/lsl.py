@@ -16,7 +16,8 @@ One case process does, on the same samples (a Birznieks ramp-hold at 1 kHz, 3 s)
 
 Both are reported per force sample that produced spikes (over LSL: until its last spike
 arrives; in process: its push, which returns all its spikes) and, in process, over all samples.
-``DDMM_NUM_THREADS`` applies to both (the bridge process inherits it).  Loopback only: the case
+``DDMM_NUM_THREADS`` applies to both (the bridge process inherits it); unset, the in-process encoder runs
+on every core and the bridge as ``ddmm stream`` defaults (one thread on a host of at most two cores).  Loopback only: the case
 writes an LSL config (``ResolveScope = machine``) and points ``LSLAPICFG`` at it.
 """
 
