@@ -211,8 +211,8 @@ def _encoder(args, fs, sites):
 def encoder_threads(threads, *, live: bool):
     """The encoder's threads for ``--threads`` (None: the default).  A parallel push waits at its end for
     every thread, and on a 2-core host a live sender and the spikes' consumers take a core from it now and
-    then: measured with the whole hand over LSL, one thread gave a p99 of 0.68-0.81 ms, two 0.85-3.9 ms
-    (docs/live-sensors.md)."""
+    then: measured with the whole hand over LSL, one thread gave a p99 of 0.63-0.86 ms in 9 runs, two
+    0.50-3.87 ms in 11 (docs/live-sensors.md)."""
     if threads is not None:
         return threads
     if live and not os.environ.get("DDMM_NUM_THREADS") and (os.cpu_count() or 1) <= 2:

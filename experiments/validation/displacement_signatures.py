@@ -43,9 +43,10 @@ import dataclasses
 import numpy as np
 
 from ddmm.models.afferent_types import is_type
+from ddmm.utils.validation import check_count
 
-__all__ = ["FREQUENCIES_HZ", "AMPLITUDES_MM", "PERIODS_MM", "N_FINGERTIPS", "ONE_PER_CYCLE", "threshold_curves", "rate_intensity",
-           "spatial_modulation", "grating_locking", "main"]
+__all__ = ["FREQUENCIES_HZ", "AMPLITUDES_MM", "PERIODS_MM", "N_FINGERTIPS", "ONE_PER_CYCLE", "threshold_curves",
+           "rate_intensity", "spatial_modulation", "grating_locking", "main"]
 
 FREQUENCIES_HZ = (5.0, 8.0, 16.0, 32.0, 64.0, 100.0, 150.0, 200.0, 250.0, 300.0, 400.0)
 AMPLITUDES_MM = tuple(np.geomspace(5e-4, 0.5, 25))
@@ -67,6 +68,7 @@ def _units_near(seed: int, n_fingertips: int = 1, n_per_type: int = 10):
     its subjects' (`touchsim_side_by_side.named_units`)."""
     from ddmm.experiments.validation.touchsim_side_by_side import named_units
 
+    n_fingertips = check_count(n_fingertips, "n_fingertips")
     return named_units(range(seed, seed + n_fingertips), per_type={t: n_per_type for t in _TYPES})
 
 
@@ -205,7 +207,7 @@ def spatial_modulation(seed: int = 3, n_fingertips: int = N_FINGERTIPS, n_offset
     """{type: modulation per period of `PERIODS_MM`} (module docstring, 4): the median over a type's units
     (the 5 SA-I, 5 FA-I and 3 FA-II nearest the centre of each of ``n_fingertips`` fingertips from seed
     ``seed``) of each unit's modulation across offsets."""
-    parts = [_unit_modulation(s, n_offsets) for s in range(seed, seed + n_fingertips)]
+    parts = [_unit_modulation(s, n_offsets) for s in range(seed, seed + check_count(n_fingertips, "n_fingertips"))]
     types = np.concatenate([kinds for kinds, _ in parts])
     index = np.concatenate([rows for _, rows in parts], axis=1)  # (period, unit)
     return {kind: np.median(index[:, types == kind], axis=1) for kind in _TYPES}

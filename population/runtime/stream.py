@@ -102,7 +102,6 @@ class Encoder:
     max_force_n : float
         The largest force (N, magnitude) a pushed sample may carry at a site,
         1 kN by default: a chunk beyond it is refused (a unit slip).
-
     threads : int, optional
         The most threads a push runs on (None: ``DDMM_NUM_THREADS``, else
         every core).  One keeps a push off the cores a live sender and its
