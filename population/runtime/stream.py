@@ -164,8 +164,8 @@ class Encoder:
         scale = pop.gain
         if self.contact is not None:
             scale = pop.gain * population_weight(pop, self.contact)
-        elif self.sites is not None:
-            scale = pop.gain * site_coverage(pop, self.sites)
+        elif self.sites is not None:  # checked on the whole population's skin, as `simulate` checks it
+            scale = pop.gain * site_coverage(self.population, self.sites)[self._order]
         self._pipeline = block_pipeline(pop, self.model_fs, self.sites, scale, self.no_shear)
         # Forward Euler refuses no chunk it was given (no stability check; the v floor and the bounded drive keep
         # it finite), so its pushes write the state in place: a copy of the state costs more than the kernels'

@@ -302,3 +302,28 @@ def test_pushes_keep_the_profile_of_a_held_shear_direction_and_turn_with_it(monk
     assert aff.size > 100
     np.testing.assert_array_equal(aff, offline.spike_afferent.values)
     np.testing.assert_array_equal(t, offline.spike_time.values)
+
+
+def test_a_pin_is_checked_on_the_whole_populations_skin_as_simulate_checks_it():
+    """With one type selected, a probe on the fingertip's skin but farther from every FA-II than their own
+    spacing allows is taken by the encoder as by `simulate`; a probe off the fingertip is refused by both."""
+    from scipy.spatial import cKDTree
+
+    from ddmm.population.stimuli.indentation import indent, probe, skin_gap_mm
+
+    pop = sample_population("fingertip", rng=0)
+    fa2 = pop.select(np.flatnonzero(pop.afferent_type == "RAII"))
+    d, _ = cKDTree(np.column_stack([fa2.x_mm, fa2.y_mm])).query(np.column_stack([pop.x_mm, pop.y_mm]))
+    k = int(np.argmax(d))
+    assert d[k] > skin_gap_mm(fa2)  # off the FA-II's own skin, on the fingertip's
+    press = np.linspace(0.0, 0.3, 200)
+    on = indent(probe(float(pop.x_mm[k]), float(pop.y_mm[k])), press, fs=5000.0)
+    offline = simulate(pop, on, engine="direct", afferent_types=["RAII"], seed=2, quiet=True)
+    enc = Encoder(pop, 5000.0, afferent_types=["RAII"], sites=on.sites, conditioning=None, seed=2)
+    out = enc.push(on.site_forces)
+    np.testing.assert_array_equal(pop.afferent_id[out.afferent], offline.afferent.values[offline.spike_afferent.values])
+    off = indent(probe(40.0, 40.0), press, fs=5000.0)
+    for run in (lambda: simulate(pop, off, engine="direct", afferent_types=["RAII"], quiet=True),
+                lambda: Encoder(pop, 5000.0, afferent_types=["RAII"], sites=off.sites, conditioning=None)):
+        with pytest.raises(ValueError, match="is off the skin of population 'fingertip'"):
+            run()
