@@ -216,13 +216,11 @@ def spatial_modulation(seed: int = 3, n_fingertips: int = N_FINGERTIPS, n_offset
 def _unit_modulation(seed: int, n_offsets: int) -> tuple:
     """(types, (period, unit) modulation) of one fingertip's nearest units.  The copies are simulated among the
     fingertip's own units under the window (not analysed), so that every pin lies on the population's skin."""
+    from ddmm.experiments.validation.touchsim_side_by_side import nearest_units
     from ddmm.population import sample_population, simulate
 
     pop = sample_population("fingertip", rng=seed)
-    r = np.hypot(pop.x_mm, pop.y_mm)
-    pick = np.concatenate([np.flatnonzero(pop.afferent_type == t)[np.argsort(r[pop.afferent_type == t])[:n]]
-                           for t, n in (("SAI", 5), ("RAI", 5), ("RAII", 3))])
-    units = pop.select(pick)
+    units = pop.select(nearest_units(pop, {"SAI": 5, "RAI": 5, "RAII": 3}))
     rows = []
     for period in PERIODS_MM:
         offsets = np.linspace(-period / 2.0, period / 2.0, n_offsets, endpoint=False)

@@ -28,7 +28,8 @@ import json
 
 import numpy as np
 
-__all__ = ["FIT_SEEDS", "HELD_OUT_SEEDS", "PAIRS", "ddmm_responses", "grating_scene", "main", "named_list", "named_units", "touchsim_summary"]
+__all__ = ["FIT_SEEDS", "HELD_OUT_SEEDS", "PAIRS", "ddmm_responses", "grating_scene", "main", "named_list",
+           "named_units", "nearest_units", "touchsim_summary"]
 
 #: ddmm's type for each TouchSim class (TouchSim fits SA1, RA and PC only).
 PAIRS = {"SA1": "SAI", "RA": "RAI", "PC": "RAII"}
@@ -61,14 +62,21 @@ def named_list() -> dict:
     return stimuli
 
 
-def _nearest(pop, per_type) -> np.ndarray:
-    """Indices of the ``per_type[t]`` units of each type t nearest the centre of ``pop``'s frame."""
+def nearest_units(pop, per_type=_UNITS) -> np.ndarray:
+    """Indices of the ``per_type[t]`` units of each type t nearest the centre of ``pop``'s frame, type by type.
+
+    Examples
+    --------
+    >>> from ddmm.population import sample_population
+    >>> nearest_units(sample_population("fingertip", rng=0), {"SAI": 2, "RAII": 1}).size
+    3
+    """
     r = np.hypot(pop.x_mm, pop.y_mm)
     return np.concatenate([np.flatnonzero(pop.afferent_type == t)[np.argsort(r[pop.afferent_type == t])[:n]]
                            for t, n in per_type.items()])
 
 
-def named_units(seeds=(0,), per_type=None):
+def named_units(seeds=(0,), per_type=_UNITS):
     """The nearest ``per_type`` units of each type (default ``_UNITS``: 4 SA-I, 9 FA-I, 4 FA-II) of the
     fingertip preset sampled with each of ``seeds`` (its ``rng``), all moved to (0, 0), pooled: each with its
     own sensitivity, gain and noise.  A unit of seed s keeps its id plus s x 10**6, so units of different seeds
@@ -78,7 +86,7 @@ def named_units(seeds=(0,), per_type=None):
     parts = []
     for seed in seeds:
         pop = sample_population("fingertip", rng=seed)
-        sub = pop.select(_nearest(pop, _UNITS if per_type is None else per_type))
+        sub = pop.select(nearest_units(pop, per_type))
         parts.append(dataclasses.replace(sub, afferent_id=sub.afferent_id + int(seed) * 10**6))
     arrays = {f.name: np.concatenate([getattr(part, f.name) for part in parts])
               for f in dataclasses.fields(parts[0]) if isinstance(getattr(parts[0], f.name), np.ndarray)}
@@ -130,7 +138,7 @@ def _grating_summary(pop, seed: int) -> dict:
     window = np.flatnonzero((np.abs(pop.x_mm) <= 4.5) & (np.abs(pop.y_mm) <= 4.5))
     sub = pop.select(window)
     ds = simulate(sub, grating_scene(), engine="direct", seed=seed, quiet=True)
-    return _summary(ds, 0.5, vs_hz=40.0, units=_nearest(sub, _UNITS))
+    return _summary(ds, 0.5, vs_hz=40.0, units=nearest_units(sub))
 
 
 def _summary(ds, duration_s: float, vs_hz: float | None = None, units=None) -> dict:
