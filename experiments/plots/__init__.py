@@ -4,7 +4,8 @@
 - `first_look`: the ramp-and-hold a physiologist looks at first;
 - `hand`: spike counts on the hand map;
 - `physiology`: the scorecard's figures;
-- `neurostim`: stimulation pulses beside the forces that made them.
+- `neurostim`: stimulation pulses beside the forces that made them;
+- `texture`: spatial event plots of scanned surfaces.
 """
 
 from ddmm.utils.lazy import lazy_exports
@@ -15,5 +16,6 @@ _WHERE = {
     "hand": ("plot_hand",),
     "physiology": ("physiology_figures",),
     "neurostim": ("plot_stimulation",),
+    "texture": ("plot_spatial_events",),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

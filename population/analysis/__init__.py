@@ -6,7 +6,8 @@
 - `ml`: the decoders as scikit-learn estimators, and `features` for them
   (needs scikit-learn: ``pip install 'ddmm[ml]'``; imported only on use);
 - `array_decode`: torque and slip from force fields;
-- `physiology`: the physiology scorecard against human recordings.
+- `physiology`: the physiology scorecard against human recordings;
+- `surface_maps`: spatial event plots of scanned surfaces (each spike placed on the surface).
 """
 
 from ddmm.utils.lazy import lazy_exports
@@ -19,5 +20,6 @@ _WHERE = {
            "circular_score", "example_features", "features"),
     "array_decode": ("CentroidClassifier", "SlipDetector", "evaluate_slip", "onset_counts", "stage_onset"),
     "physiology": ("PROPERTIES", "score_physiology", "summarise_scorecard"),
+    "surface_maps": ("ScanPath", "event_rate_map", "relief_correlation", "spatial_events"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)
