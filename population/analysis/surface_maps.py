@@ -41,6 +41,8 @@ __all__ = ["ScanPath", "spatial_events", "event_rate_map", "relief_correlation"]
 
 #: Path samples per bin crossed when the dwell time is integrated (`event_rate_map`).
 _DWELL_SAMPLES_PER_BIN = 8
+#: Path points held at once (a block of afferents' paths): bounds the memory of a long, fast scan at fine bins.
+_DWELL_POINTS = 1 << 22
 
 
 @dataclass(frozen=True)
@@ -183,13 +185,9 @@ def event_rate_map(dataset, path: ScanPath, afferent_type: str, *, bin_mm: float
     ds, bin_mm = dataset, check_positive(bin_mm, "bin_mm", "mm")
     check_choice(afferent_type, "afferent_type", sorted(set(ds.afferent_type.values.astype(str))))
     chosen = np.flatnonzero(_afferent_mask(ds, afferents) & (ds.afferent_type.values.astype(str) == afferent_type))
-    n_steps = int(np.ceil(path.duration_s * _DWELL_SAMPLES_PER_BIN * path.speed_mm_s / bin_mm))
-    step = path.duration_s / n_steps  # the centres' path at the middle of each step, bin_mm / 8 apart at most
-    t = (np.arange(n_steps) + 0.5) * step
-    qx, qy = path.surface_point(ds.x_mm.values[chosen][:, None], ds.y_mm.values[chosen][:, None], t[None, :])
-    x_edges, y_edges = _edges(extent_mm, qx, qy, bin_mm)
-    trials = int(ds.sizes["trial"])
-    dwell = np.histogram2d(qy.ravel(), qx.ravel(), (y_edges, x_edges))[0] * step * trials
+    x, y = ds.x_mm.values[chosen], ds.y_mm.values[chosen]
+    dwell, (x_edges, y_edges) = _dwell(path, x, y, bin_mm, extent_mm)
+    dwell *= int(ds.sizes["trial"])
     mine = events.afferent_type.values.astype(str) == afferent_type
     counts = np.histogram2d(events.surface_y_mm.values[mine], events.surface_x_mm.values[mine], (y_edges, x_edges))[0]
     rate = np.full(dwell.shape, np.nan)
@@ -236,6 +234,22 @@ def relief_correlation(rate_map, surface) -> float:
     if np.ptp(rate) == 0.0:
         return 0.0
     return float(np.corrcoef(rate, height)[0, 1])
+
+
+def _dwell(path, x, y, bin_mm, extent_mm) -> tuple:
+    """(time in s the centres (``x``, ``y``) spent over each bin, (x edges, y edges)): each path sampled at the
+    middle of steps that move it ``bin_mm / _DWELL_SAMPLES_PER_BIN`` at most, a block of afferents at a time."""
+    n_steps = int(np.ceil(path.duration_s * _DWELL_SAMPLES_PER_BIN * path.speed_mm_s / bin_mm))
+    step = path.duration_s / n_steps
+    t = (np.arange(n_steps) + 0.5) * step
+    ends = path.surface_point(x[:, None], y[:, None], t[[0, -1]][None, :])  # straight paths: their ends bound them
+    edges = _edges(extent_mm, *ends, bin_mm)
+    dwell = np.zeros((edges[1].size - 1, edges[0].size - 1))
+    block = max(1, _DWELL_POINTS // n_steps)
+    for a0 in range(0, x.size, block):
+        qx, qy = path.surface_point(x[a0:a0 + block, None], y[a0:a0 + block, None], t[None, :])
+        dwell += np.histogram2d(qy.ravel(), qx.ravel(), edges[::-1])[0]
+    return dwell * step, edges
 
 
 def _condition(ds, condition) -> int:

@@ -73,6 +73,17 @@ def test_uniform_firing_gives_a_flat_rate_map_over_the_crossed_bins_and_nan_else
     assert m.attrs["dwell_s"] == pytest.approx(2 * 2 * duration)  # two units, two trials, the whole scan
 
 
+def test_paths_integrated_a_block_of_afferents_at_a_time_give_the_same_map(monkeypatch):
+    import ddmm.population.analysis.surface_maps as maps
+
+    x = np.linspace(-2.0, 2.0, 7)
+    ds = _dataset(x, x[::-1], ["SAI"] * 7, [np.arange(0.01, 0.5, 0.013)] * 7)
+    path = ScanPath(30.0, 0.5, direction_deg=30.0)
+    whole = event_rate_map(ds, path, "SAI", bin_mm=0.3)
+    monkeypatch.setattr(maps, "_DWELL_POINTS", 100)  # a block of one afferent's path at a time
+    np.testing.assert_array_equal(event_rate_map(ds, path, "SAI", bin_mm=0.3).values, whole.values)
+
+
 def test_the_relief_correlation_is_one_for_a_map_that_draws_the_relief_and_zero_for_a_flat_one():
     s = grating(2.0)
     x = np.arange(-2.0, 2.0, 0.25) + 0.125
