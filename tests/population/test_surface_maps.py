@@ -96,12 +96,12 @@ def test_the_relief_correlation_is_one_for_a_map_that_draws_the_relief_and_zero_
 
 
 def test_scanned_letters_are_drawn_by_sa_i_best_fa_i_less_and_fa_ii_not_at_all():
-    """Held out (docs/validation.md, "Letters scanned"): the letter protocol on fingertip seed 2, the
+    """Held out (docs/validation.md, "Patterns scanned"): the letter protocol on fingertip seed 2, the
     weakest of the four fingertips run (SA-I r 0.21-0.28, FA-I 0.06-0.13, FA-II -0.21-0.02)."""
-    from ddmm.experiments.validation.letter_scans import letter_run, letter_scene, relief_correlations
+    from ddmm.experiments.validation.pattern_scans import fingertip_run, pattern_scene, relief_correlations
 
-    scene, surface, path = letter_scene()
-    ds, inner = letter_run(2, scene)
+    scene, surface, path = pattern_scene("letters")
+    ds, inner = fingertip_run(2, scene)
     r = {kind: value[0] for kind, value in relief_correlations(ds, inner, surface, path).items()}
     assert r["SAI"] > r["RAI"] > r["RAII"]
     assert r["SAI"] > 0.15 and abs(r["RAII"]) < 0.1

@@ -1,4 +1,4 @@
-"""The letter scans' script and its spatial event plot (`experiments/validation/letter_scans.py`,
+"""The pattern scans' script and its spatial event plot (`experiments/validation/pattern_scans.py`,
 `experiments/plots/texture.py`)."""
 
 import numpy as np
@@ -7,7 +7,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from ddmm.experiments.plots.texture import plot_spatial_events
-from ddmm.experiments.validation import letter_scans
+from ddmm.experiments.validation import pattern_scans
 from ddmm.population.stimuli.surfaces import letters
 
 
@@ -27,16 +27,16 @@ def test_the_plot_has_a_panel_per_type_present_and_draws_the_relief_under_the_sp
 
 
 def test_the_script_prints_held_out_correlations_and_writes_the_plot(tmp_path, capsys):
-    assert letter_scans.main(["--seeds", "2", "--out", str(tmp_path)]) == 0
+    assert pattern_scans.main(["--seeds", "2", "--patterns", "dots", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert "HELD OUT" in out and "seed 2: SAI r" in out and "ordering held on 1 of 1 fingertips" in out
-    assert (tmp_path / "letter_sep.png").stat().st_size > 10_000
+    assert "HELD OUT" in out and "dots, seed 2: SAI r" in out and "dots: ordering held on 1 of 1 fingertips" in out
+    assert (tmp_path / "dots_sep.png").stat().st_size > 10_000 and not (tmp_path / "letters_sep.png").exists()
 
 
 def test_the_script_refuses_an_output_path_that_is_a_file_before_running(tmp_path, capsys):
     blocker = tmp_path / "file"
     blocker.write_text("x")
     with pytest.raises(SystemExit) as exit_info:
-        letter_scans.main(["--out", str(blocker)])
+        pattern_scans.main(["--out", str(blocker)])
     assert exit_info.value.code == 2
     assert "cannot be created: File exists" in capsys.readouterr().err
