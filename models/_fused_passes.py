@@ -69,14 +69,13 @@ from ddmm.models._fused_tables import (
 from ddmm.models._stage_kernels import (
     StageConstants,
     TailState,
-    TransducerPass,
     UnitScales,
     dynamic_step,
     filter_sections,
     receptor_noise_keyed,
     stage_tail,
-    transduce_pre,
 )
+from ddmm.models._transducer_kernels import TransducerPass, transduce_pre
 from ddmm.models.rng import normal_row
 
 

@@ -34,7 +34,7 @@ afferent ranges in parallel (`_front_parts`): afferents are independent, so
 the bits are the same.  A streaming push (`FusedPipeline.push_drive`) runs
 the front pass per range with the transducers' first pass, keeps each
 range's profile AF from push to push, and leaves the transducers' last pass
-to the engine's own parallel region (`ddmm.models._stage_kernels.TransducerRuns`).
+to the engine's own parallel region (`ddmm.models._transducer_kernels.TransducerRuns`).
 
 Because the scalar helpers are the very functions the oracle's kernels
 call, and every operation keeps their order, the result is bit-identical to
@@ -64,7 +64,7 @@ from ddmm.models._fused_tables import (
     transducer_runs,
     type_runs,
 )
-from ddmm.models._stage_kernels import (
+from ddmm.models._transducer_kernels import (
     transducer_table,
     transduce_columns,
     transduce_inplace,

@@ -40,8 +40,8 @@ from ddmm.models._stage_kernels import (
     dynamic_kernel,
     smooth_kernel,
     stage_kernel,
-    transduce_inplace,
 )
+from ddmm.models._transducer_kernels import transduce_inplace
 from ddmm.models.afferent_types import afferent_type_codes, afferent_type_info, normalize_type
 from ddmm.models.attenuation import F_TH, attenuation_factor, profile_factor, shear_magnitude
 from ddmm.models.current_filters import _stage_sos, check_fs, type_filter_constants

@@ -20,7 +20,7 @@ import numba as nb
 import numpy as np
 
 from ddmm.models._fused_tables import FusedTables, NoiseKey
-from ddmm.models._stage_kernels import TransducerPass, transduce_post
+from ddmm.models._transducer_kernels import TransducerPass, transduce_post
 from ddmm.models.engines import NeuronState, check_integration, check_stability, substeps_for
 from ddmm.models.engines.direct import (
     PUSH_BLOCK,

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.population.stimuli._contact_kernels import contact_loads, rate, surface_wave
+from ddmm.population.stimuli._contact_kernels import contact_loads, distance, rate, sigma_z_unit, surface_wave
 from ddmm.utils.resources import check_memory
 from ddmm.utils.validation import (
     as_finite_array,
@@ -211,11 +211,6 @@ def _xy(x_mm, y_mm, what: str) -> tuple[np.ndarray, np.ndarray]:
     return x, y
 
 
-def _distance(x1, y1, x2, y2) -> np.ndarray:
-    """Centre distances in mm, shape (len(x1), len(x2))."""
-    return np.hypot(x1[:, None] - x2[None, :], y1[:, None] - y2[None, :])
-
-
 def _skin(skin) -> SkinMechanics:
     return check_instance(skin, "skin", SkinMechanics, "a SkinMechanics (e.g. get_skin_mechanics('default'))")
 
@@ -241,7 +236,7 @@ def effective_radius(x_mm, y_mm, radius_mm, skin) -> float:
     skin = _skin(skin)
     if x.size == 1:
         return a
-    dist = _distance(x, y, x, y)
+    dist = distance(x, y, x, y)
     np.fill_diagonal(dist, np.inf)
     i, j = sorted(np.unravel_index(int(np.argmin(dist)), dist.shape))
     nearest = float(dist[i, j])
@@ -276,7 +271,7 @@ def pin_compliance(x_mm, y_mm, radius_mm, skin) -> np.ndarray:
     skin = _skin(skin)
     a = effective_radius(x_mm, y_mm, radius_mm, skin)
     x, y = _xy(x_mm, y_mm, "pin")
-    r = _distance(x, y, x, y)
+    r = distance(x, y, x, y)
     scale = (1.0 - skin.poisson ** 2) / skin.modulus_n_mm2
     outside = r > a
     out = np.full(r.shape, scale / (2.0 * a))
@@ -320,17 +315,6 @@ def solve_pin_loads(depth_mm, x_mm, y_mm, radius_mm, skin) -> np.ndarray:
         s, p = np.argwhere(depth < 0.0)[0]
         raise ValueError(f"depth_mm must be >= 0 mm (into the skin); got {shown(depth[s, p])} at sample {s}, pin {p}")
     return contact_loads(depth, pin_compliance(x_mm, y_mm, radius_mm, skin))
-
-
-def _sigma_z_unit(rho: np.ndarray, xi: np.ndarray) -> np.ndarray:
-    """Sneddon's sigma_z * 2 pi a^2 / P at rho = r / a, xi = z / a > 0 (dimensionless)."""
-    s = rho ** 2 + xi ** 2 - 1.0
-    big_r = np.sqrt(s ** 2 + 4.0 * xi ** 2)
-    phi = np.arctan2(2.0 * xi, s)
-    theta = np.arctan(1.0 / xi)
-    j1 = np.sin(phi / 2.0) / np.sqrt(big_r)
-    j2 = np.sqrt(1.0 + xi ** 2) * np.sin(1.5 * phi - theta) / big_r ** 1.5
-    return j1 + xi * j2
 
 
 def _receptors(x_mm, y_mm, depth_mm) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -381,8 +365,8 @@ def stress_kernel(pin_x, pin_y, radius_mm, x_mm, y_mm, depth_mm) -> np.ndarray:
     x, y, z = _receptors(x_mm, y_mm, depth_mm)
     a = check_positive(radius_mm, "radius_mm", "mm")
     check_memory(48.0 * px.size * x.size, f"a stress kernel of {px.size} pins x {x.size} points", "use fewer points")
-    rho = _distance(px, py, x, y) / a
-    return _MPA / (2.0 * np.pi * a * a) * _sigma_z_unit(rho, z[None, :] / a)
+    rho = distance(px, py, x, y) / a
+    return _MPA / (2.0 * np.pi * a * a) * sigma_z_unit(rho, z[None, :] / a)
 
 
 def _loads(loads, n_pins: int) -> np.ndarray:
@@ -461,7 +445,7 @@ def dynamic_stress(loads, pin_x, pin_y, radius_mm, x_mm, y_mm, depth_mm, fs, ski
                  "use fewer samples or points")
     if skin.dynamic == "derivative":  # linear: the rate of loads @ kernel is the loads' rate @ kernel
         return rate(arr, fs, "one_sided") @ stress_kernel(px, py, a, x, y, z)
-    return _MPA * surface_wave(rate(arr, fs, "copy"), _distance(px, py, x, y), a, z, fs, skin.wave_speed_mm_s)
+    return _MPA * surface_wave(rate(arr, fs, "copy"), distance(px, py, x, y), a, z, fs, skin.wave_speed_mm_s)
 
 
 def tangential_loads(lateral_mm, loads, radius_mm, skin) -> np.ndarray:

@@ -155,7 +155,7 @@ def _signed_derivative(f, kind):
 def test_fused_transducer_equals_the_stage_transducer(seed, kind, excited, live, lo, width):
     # `transduce_columns` (the fused pipeline's) against `transduce_inplace` (the stages'), bit for bit, on
     # columns lo..lo+width of a drive whose rows are zero or not in any pattern (it skips all-zero rows).
-    from ddmm.models._stage_kernels import transduce_columns, transduce_inplace
+    from ddmm.models._transducer_kernels import transduce_columns, transduce_inplace
     from ddmm.models.currents import type_filter_constants
 
     rng = np.random.default_rng(seed)
@@ -171,7 +171,7 @@ def test_fused_transducer_equals_the_stage_transducer(seed, kind, excited, live,
 
 
 def test_fused_transducer_refuses_a_signed_stage():
-    from ddmm.models._stage_kernels import transduce_columns
+    from ddmm.models._transducer_kernels import transduce_columns
     from ddmm.models.currents import type_filter_constants
 
     with pytest.raises(ValueError, match="unsigned"):
