@@ -32,17 +32,18 @@ from ddmm.experiments.io import ensure_out_dir, seed_arg
 
 __all__ = ["PATTERNS", "SPEED_MM_S", "DURATION_S", "pattern_scene", "fingertip_run", "relief_correlations", "main"]
 
-#: The scanned patterns by name, as made (`ddmm.population.stimuli.surfaces`).
-PATTERNS = {"letters": "letters('AB')", "dots": "dot_pattern(3.0)"}
+#: The scanned patterns by name: the `ddmm.population.stimuli.surfaces` function that makes each, and its arguments.
+PATTERNS = {"letters": ("letters", ("AB",)), "dots": ("dot_pattern", (3.0,))}
 SPEED_MM_S, DURATION_S = 40.0, 0.6
 _CONTACT_MM, _PITCH_MM, _WINDOW_MM, _INNER_MM, _BIN_MM = 0.5, 0.25, 10.0, 3.5, 0.25
 _TYPES = ("SAI", "RAI", "RAII")
 
 
 def _surface(name: str):
-    from ddmm.population.stimuli.surfaces import dot_pattern, letters
+    from ddmm.population.stimuli import surfaces
 
-    return {"letters": lambda: letters("AB"), "dots": lambda: dot_pattern(3.0)}[name]()
+    maker, args = PATTERNS[name]
+    return getattr(surfaces, maker)(*args)
 
 
 def pattern_scene(name: str = "letters"):

@@ -76,7 +76,10 @@ class ScanPath:
         object.__setattr__(self, "speed_mm_s", check_positive(self.speed_mm_s, "speed_mm_s", "mm/s"))
         object.__setattr__(self, "duration_s", check_positive(self.duration_s, "duration_s", "s"))
         object.__setattr__(self, "direction_deg", check_real(self.direction_deg, "direction_deg", "deg"))
-        centre = np.asarray(self.center_mm, dtype=float) if np.ndim(self.center_mm) == 1 else np.zeros(0)
+        try:
+            centre = np.asarray(self.center_mm, dtype=float) if np.ndim(self.center_mm) == 1 else np.zeros(0)
+        except (TypeError, ValueError):
+            centre = np.zeros(0)
         if centre.shape != (2,) or not np.all(np.isfinite(centre)):
             raise ValueError(f"center_mm must be two finite numbers (x, y) in mm, got {self.center_mm!r}")
         object.__setattr__(self, "center_mm", (float(centre[0]), float(centre[1])))

@@ -121,6 +121,7 @@ def test_scanned_letters_are_drawn_by_sa_i_best_fa_i_less_and_fa_ii_not_at_all()
     (lambda ds: event_rate_map(ds, ScanPath(40.0, 1.0), "SAI", afferents=[1]), ValueError, "no afferent"),
     (lambda ds: ScanPath(0.0, 1.0), ValueError, "speed_mm_s"),
     (lambda ds: ScanPath(40.0, 1.0, center_mm=(0.0,)), ValueError, "center_mm must be two finite numbers"),
+    (lambda ds: ScanPath(40.0, 1.0, center_mm=("a", "b")), ValueError, "center_mm must be two finite numbers"),
 ])
 def test_bad_input_is_refused_naming_the_argument(call, error, match):
     ds = _dataset([0.0, 1.0], [0.0, 0.0], ["SAI", "RAI"], [[0.1], [0.2]])
