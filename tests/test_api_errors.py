@@ -300,6 +300,8 @@ ROWS = [
     (S.from_bitmap, {"array": [[0.0, 2.0]], "pixel_mm": 0.1, "relief_mm": 0.5}, "array"),
     (S.min_scan_fs, {"speed_mm_s": 0.0, "pixel_mm": 0.05}, "speed_mm_s"),
     (S.scan, {"surface": "grating"}, "surface"),
+    (S.scan_depths, {"surface": "grating"}, "surface"),
+    (S.scan_depths, {"surface": S.grating(1.0), "pitch_mm": -0.2}, "pitch_mm"),
     (S.scan, {"surface": S.grating(1.0), "speed_mm_s": 40.0, "fs": 100.0}, "fs"),
     (P.Conditioning, {"noise_n": -1.0}, "noise_n"),
     (P.Conditioning, {"mode": "psychic"}, "mode"),

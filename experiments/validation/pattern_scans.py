@@ -14,29 +14,45 @@ Target (Johnson & Lamb 1981; Phillips, Johnson & Hsiao 1988; recalled, docs/refe
 spatial event plots of scanned dot patterns and letters, SA-I draw the pattern most sharply, FA-I blurred,
 FA-II not at all: r of SA-I > FA-I > FA-II.
 
+TouchSim beside it: its single models (noise off), one per unit at the positions of the units analysed, the
+models of a class taken in turn, on the same pins and depths (`ddmm.population.stimuli.surfaces.scan_depths`;
+TouchSim's skin is normal-only), scored the same way.  Record them where TouchSim and ddmm are both installed
+(the fixture holds TouchSim's commit)::
+
+    python -m ddmm.experiments.validation.pattern_scans --record tests/population/data/touchsim_pattern_scans.json
+
 Run::
 
-    python -m ddmm.experiments.validation.pattern_scans [--seeds 1 2 3 4] [--out DIR]
+    python -m ddmm.experiments.validation.pattern_scans [--seeds 1 2 3 4] [--out DIR] \
+        [--touchsim tests/population/data/touchsim_pattern_scans.json]
 
-``--out`` writes ``<pattern>_sep.png``, the first seed's spatial event plot of each pattern.
+``--out`` writes ``<pattern>_sep.png``, the first seed's spatial event plot of each pattern; ``--touchsim``
+prints TouchSim's recorded r beside ddmm's for the seeds it holds.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.metadata
+import json
 from pathlib import Path
 
 import numpy as np
 
-from ddmm.experiments.io import ensure_out_dir, seed_arg
+from ddmm.experiments.io import ensure_out_dir, save_json, seed_arg
 
-__all__ = ["PATTERNS", "SPEED_MM_S", "DURATION_S", "pattern_scene", "fingertip_run", "relief_correlations", "main"]
+__all__ = ["PATTERNS", "SPEED_MM_S", "DURATION_S", "TOUCHSIM_COMMIT", "pattern_scene", "fingertip_run",
+           "relief_correlations", "record_touchsim", "main"]
 
 #: The scanned patterns by name: the `ddmm.population.stimuli.surfaces` function that makes each, and its arguments.
 PATTERNS = {"letters": ("letters", ("AB",)), "dots": ("dot_pattern", (3.0,))}
 SPEED_MM_S, DURATION_S = 40.0, 0.6
 _CONTACT_MM, _PITCH_MM, _WINDOW_MM, _INNER_MM, _BIN_MM = 0.5, 0.25, 10.0, 3.5, 0.25
 _TYPES = ("SAI", "RAI", "RAII")
+_CLASSES = {"SAI": "SA1", "RAI": "RA", "RAII": "PC"}  # ddmm's type -> TouchSim's class
+TOUCHSIM_COMMIT = "4ec9f5c382e7d48410566de743d7a4f05de75cec"
+_SCAN = {"speed_mm_s": SPEED_MM_S, "duration_s": DURATION_S, "contact_mm": _CONTACT_MM,
+         "window_mm": (_WINDOW_MM, _WINDOW_MM), "pitch_mm": _PITCH_MM}
 
 
 def _surface(name: str):
@@ -53,21 +69,26 @@ def pattern_scene(name: str = "letters"):
     from ddmm.utils.validation import check_choice
 
     surface = _surface(check_choice(name, "name", sorted(PATTERNS)))
-    scene = scan(surface, speed_mm_s=SPEED_MM_S, duration_s=DURATION_S, contact_mm=_CONTACT_MM,
-                 window_mm=(_WINDOW_MM, _WINDOW_MM), pitch_mm=_PITCH_MM, name=f"scan_{name}")
-    return scene, surface, ScanPath(SPEED_MM_S, DURATION_S)
+    return scan(surface, **_SCAN, name=f"scan_{name}"), surface, ScanPath(SPEED_MM_S, DURATION_S)
 
 
 def fingertip_run(seed: int, scene) -> tuple:
     """(dataset, inner): the fingertip of ``seed``'s units under the window run on ``scene`` (noise seed ``seed``),
     and the positions of those whose centre lies in the inner 7 x 7 mm."""
-    from ddmm.population import sample_population, simulate
+    from ddmm.population import simulate
+
+    sub, inner = _window_units(seed)
+    return simulate(sub, scene, engine="direct", seed=seed, quiet=True), inner
+
+
+def _window_units(seed: int) -> tuple:
+    """(the fingertip of ``seed``'s units under the window, positions of those in the inner 7 x 7 mm)."""
+    from ddmm.population import sample_population
 
     pop = sample_population("fingertip", rng=seed)
     half = _WINDOW_MM / 2.0
     sub = pop.select(np.flatnonzero((np.abs(pop.x_mm) <= half) & (np.abs(pop.y_mm) <= half)))
-    inner = np.flatnonzero((np.abs(sub.x_mm) <= _INNER_MM) & (np.abs(sub.y_mm) <= _INNER_MM))
-    return simulate(sub, scene, engine="direct", seed=seed, quiet=True), inner
+    return sub, np.flatnonzero((np.abs(sub.x_mm) <= _INNER_MM) & (np.abs(sub.y_mm) <= _INNER_MM))
 
 
 def _extent(surface) -> tuple:
@@ -88,6 +109,55 @@ def relief_correlations(ds, inner, surface, path) -> dict:
     return out
 
 
+def record_touchsim(seeds=(1, 2, 3, 4)) -> dict:
+    """{pattern: {seed: {type: [r, mean rate]}}} of TouchSim's single models on each pattern (module docstring);
+    needs TouchSim (``import touchsim``) beside ddmm."""
+    import touchsim as ts
+
+    from ddmm.population.analysis.surface_maps import ScanPath
+    from ddmm.population.stimuli.surfaces import scan_depths
+
+    out = {}
+    for name in PATTERNS:
+        surface = _surface(name)
+        pins, depth, fs = scan_depths(surface, **_SCAN)
+        stim = ts.Stimulus(location=np.column_stack([pins.x_mm, pins.y_mm]), trace=depth.T, fs=fs,
+                           pin_radius=float(np.min(pins.radius_mm)))
+        out[name] = {}
+        for seed in seeds:
+            sub, inner = _window_units(seed)
+            keep = [j for j in inner if str(sub.afferent_type[j]) in _CLASSES]
+            turn = {cls: 0 for cls in _CLASSES.values()}
+            models = []
+            for j in keep:
+                cls = _CLASSES[str(sub.afferent_type[j])]
+                idx, turn[cls] = turn[cls] % len(ts.Afferent.affparams[cls]), turn[cls] + 1
+                models.append(ts.Afferent(cls, location=[sub.x_mm[j], sub.y_mm[j]], idx=idx, noisy=False))
+            spikes = ts.AfferentPopulation(*models).response(stim).spikes
+            ds = _spike_dataset(sub.x_mm[keep], sub.y_mm[keep], sub.afferent_type[keep], spikes)
+            res = relief_correlations(ds, np.arange(len(keep)), surface, ScanPath(SPEED_MM_S, DURATION_S))
+            out[name][str(seed)] = {kind: [round(r, 4), round(rate, 3)] for kind, (r, rate, _) in res.items()}
+    return out
+
+
+def _spike_dataset(x_mm, y_mm, types, spikes):
+    """A one-condition, one-trial run in the simulator's schema (the fields `surface_maps` reads) of units at
+    (``x_mm``, ``y_mm``) of ``types`` with spike times ``spikes`` (s, one array per unit)."""
+    import xarray as xr
+
+    times = [np.asarray(s, dtype=float).ravel() for s in spikes]
+    t = np.concatenate(times) if times else np.zeros(0)
+    owner = np.concatenate([np.full(u.size, j) for j, u in enumerate(times)]).astype(np.int32) if times else \
+        np.zeros(0, np.int32)
+    zeros = np.zeros(t.size, np.int32)
+    return xr.Dataset({"spike_time": ("spike", t), "spike_afferent": ("spike", owner), "spike_trial": ("spike", zeros),
+                       "spike_condition": ("spike", zeros),
+                       "spike_count": (("condition", "trial", "afferent"), np.array([[[u.size for u in times]]]))},
+                      coords={"afferent_type": ("afferent", np.asarray(types).astype(object)),
+                              "x_mm": ("afferent", np.asarray(x_mm, dtype=float)),
+                              "y_mm": ("afferent", np.asarray(y_mm, dtype=float))})
+
+
 def main(argv=None) -> int:
     """Print each pattern's and seed's correlations, labelled held out, with the target; ``--out`` writes the
     first seed's plots."""
@@ -95,7 +165,17 @@ def main(argv=None) -> int:
     parser.add_argument("--seeds", type=seed_arg, nargs="+", default=[1, 2, 3, 4], help="fingertip and noise seeds")
     parser.add_argument("--patterns", nargs="+", choices=sorted(PATTERNS), default=list(PATTERNS))
     parser.add_argument("--out", type=Path, help="directory for <pattern>_sep.png")
+    parser.add_argument("--touchsim", type=Path, help="TouchSim's recorded correlations (JSON) to print beside ddmm's")
+    parser.add_argument("--record", type=Path, help="run TouchSim (and nothing else) and write its correlations here")
     args = parser.parse_args(argv)
+    if args.record is not None:
+        recording = {"what": __doc__.splitlines()[0], "touchsim": {
+            "commit": TOUCHSIM_COMMIT, "version": importlib.metadata.version("touchsim")},
+            "scan": {**_SCAN, "window_mm": list(_SCAN["window_mm"])}, "patterns": PATTERNS,
+            "correlations": record_touchsim(args.seeds)}
+        save_json(recording, args.record)
+        return 0
+    theirs = json.loads(args.touchsim.read_text())["correlations"] if args.touchsim is not None else {}
     try:  # before the runs: a bad directory fails at once
         out = ensure_out_dir(args.out) if args.out is not None else None
     except ValueError as exc:
@@ -113,6 +193,10 @@ def main(argv=None) -> int:
             held += ordered
             cells = "; ".join(f"{kind} r {r:.2f} ({rate:.1f} imp/s, {n} units)" for kind, (r, rate, n) in res.items())
             print(f"  {name}, seed {seed}: {cells}: {'ordered' if ordered else 'NOT ordered'}")
+            if str(seed) in theirs.get(name, {}):
+                ts_r = theirs[name][str(seed)]
+                print("    TouchSim (recorded): " + "; ".join(f"{_CLASSES[k]} r {ts_r[k][0]:.2f} ({ts_r[k][1]:.1f} imp/s)"
+                                                          for k in _TYPES))
             if k == 0 and out is not None:
                 _save_plot(ds, inner, surface, path, out / f"{name}_sep.png")
         print(f"  {name}: ordering held on {held} of {len(args.seeds)} fingertips")

@@ -46,7 +46,8 @@ from ddmm.utils.validation import (
     shown,
 )
 
-__all__ = ["FONT_5X7", "Surface", "dot_pattern", "from_bitmap", "grating", "letters", "min_scan_fs", "scan"]
+__all__ = ["FONT_5X7", "Surface", "dot_pattern", "from_bitmap", "grating", "letters", "min_scan_fs", "scan",
+           "scan_depths"]
 
 #: Widest scan window side in mm (a fingertip's contact patch is about 10 x 15 mm).
 MAX_WINDOW_MM = 20.0
@@ -445,6 +446,47 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
     >>> s.n_sites, s.n_samples, s.fs, bool(s.fz.max() > 0), bool(s.fx.max() > 0)
     (16, 125, 2500.0, True, True)
     """
+    skin = _scan_skin(skin, friction)
+    pins, depth, travel, unit, fs = _scan_track(surface, speed_mm_s, direction_deg, duration_s, contact_mm, window_mm,
+                                                pitch_mm, fs, center_mm, ramp_s, friction)
+    lateral = travel[:, None] * unit[None, :] if friction else None
+    if name is None:
+        name = f"scan_{float(speed_mm_s):g}mm_s_{np.rad2deg(np.deg2rad(float(direction_deg))):g}deg"
+    return indent(pins, depth, fs=fs, lateral_mm=lateral, skin=skin, transduction=transduction, name=name)
+
+
+def scan_depths(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0.0, duration_s: float = 1.0,
+                contact_mm: float = 0.8, window_mm=(8.0, 8.0), pitch_mm: float = 0.2, fs: float | None = None,
+                center_mm=(0.0, 0.0), ramp_s: float = 0.0) -> tuple:
+    """The pins `scan` presses and their depths: the same stimulus as normal traces, for a model that takes pin
+    depths (TouchSim's ``Stimulus(location=..., trace=depth.T, fs=fs, pin_radius=...)``).
+
+    Arguments as `scan`'s of the same names (friction and the skin act after the depths).
+
+    Returns
+    -------
+    pins : Pins
+        The window's pins (positions and radius in mm).
+    depth : ndarray, shape (n_samples, n_pins)
+        Each pin's depth into the skin in mm (>= 0).
+    fs : float
+        Sample rate in Hz (`scan`'s default when ``fs`` is None).
+
+    Examples
+    --------
+    >>> pins, depth, fs = scan_depths(grating(1.0), duration_s=0.05, window_mm=(2.0, 2.0), pitch_mm=0.5)
+    >>> len(pins), depth.shape, fs, float(depth.max())
+    (16, (125, 16), 2500.0, 0.8)
+    """
+    pins, depth, _, _, fs = _scan_track(surface, speed_mm_s, direction_deg, duration_s, contact_mm, window_mm, pitch_mm,
+                                        fs, center_mm, ramp_s, False)
+    return pins, depth, fs
+
+
+def _scan_track(surface, speed_mm_s, direction_deg, duration_s, contact_mm, window_mm, pitch_mm, fs, center_mm, ramp_s,
+                friction) -> tuple:
+    """`scan`'s pins, their depths (n_samples, n_pins) mm, the travel (n_samples,) mm along the unit direction
+    (2,), and the sample rate in Hz; the arguments validated."""
     speed, contact, fs = _check_scan(surface, speed_mm_s, contact_mm, fs)
     angle = np.deg2rad(check_real(direction_deg, "direction_deg", "deg"))
     duration = check_positive(duration_s, "duration_s", "s")
@@ -452,7 +494,6 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
     if ramp > duration:
         raise ValueError(f"ramp_s={shown(ramp)} s must be at most duration_s={shown(duration)} s")
     pins = _window_pins(window_mm, check_positive(pitch_mm, "pitch_mm", "mm"), center_mm)
-    skin = _scan_skin(skin, friction)
     # `indent`'s peak while the scan holds the heights and the depths (two more (samples, pins) arrays)
     check_memory(_indent_bytes(duration * fs, len(pins), friction, held=2), f"a scan of {duration * fs:.0f} samples "
                  f"x {len(pins)} pins", "use fewer pins or samples")
@@ -467,6 +508,4 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
     depth = np.maximum(contact - (surface.max_height_mm - h), 0.0)
     if ramp > 0.0:  # lowered in while it slides: the onset no longer steps every pin at once
         depth *= np.minimum(np.arange(n) / (ramp * fs), 1.0)[:, None]
-    lateral = travel[:, None] * unit[None, :] if friction else None
-    name = f"scan_{speed:g}mm_s_{np.rad2deg(angle):g}deg" if name is None else name
-    return indent(pins, depth, fs=fs, lateral_mm=lateral, skin=skin, transduction=transduction, name=name)
+    return pins, depth, travel, unit, fs

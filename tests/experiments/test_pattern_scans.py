@@ -1,6 +1,8 @@
 """The pattern scans' script and its spatial event plot (`experiments/validation/pattern_scans.py`,
 `experiments/plots/texture.py`)."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -26,10 +28,13 @@ def test_the_plot_has_a_panel_per_type_present_and_draws_the_relief_under_the_sp
     assert len(plot_spatial_events(_events([])).axes) == 1  # no spike: one empty panel, no error
 
 
-def test_the_script_prints_held_out_correlations_and_writes_the_plot(tmp_path, capsys):
-    assert pattern_scans.main(["--seeds", "2", "--patterns", "dots", "--out", str(tmp_path)]) == 0
+def test_the_script_prints_held_out_correlations_beside_touchsims_and_writes_the_plot(tmp_path, capsys):
+    fixture = Path(__file__).parents[1] / "population" / "data" / "touchsim_pattern_scans.json"
+    assert pattern_scans.main(["--seeds", "2", "--patterns", "dots", "--out", str(tmp_path),
+                               "--touchsim", str(fixture)]) == 0
     out = capsys.readouterr().out
     assert "HELD OUT" in out and "dots, seed 2: SAI r" in out and "dots: ordering held on 1 of 1 fingertips" in out
+    assert "TouchSim (recorded): SA1 r 0.32" in out
     assert (tmp_path / "dots_sep.png").stat().st_size > 10_000 and not (tmp_path / "letters_sep.png").exists()
 
 

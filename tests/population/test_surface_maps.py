@@ -95,9 +95,13 @@ def test_the_relief_correlation_is_one_for_a_map_that_draws_the_relief_and_zero_
     assert relief_correlation(xr.full_like(drawn, 7.0), s) == 0.0
 
 
-def test_scanned_letters_are_drawn_by_sa_i_best_fa_i_less_and_fa_ii_not_at_all():
+def test_scanned_letters_are_drawn_by_sa_i_best_fa_i_less_and_fa_ii_not_at_all_as_by_touchsim():
     """Held out (docs/validation.md, "Patterns scanned"): the letter protocol on fingertip seed 2, the
-    weakest of the four fingertips run (SA-I r 0.21-0.28, FA-I 0.06-0.13, FA-II -0.21-0.02)."""
+    weakest of the four fingertips run (SA-I r 0.21-0.28, FA-I 0.06-0.13, FA-II -0.21-0.02), beside
+    TouchSim's single models at the same units' positions on the same pins (recorded at its commit 4ec9f5c)."""
+    import json
+    from pathlib import Path
+
     from ddmm.experiments.validation.pattern_scans import fingertip_run, pattern_scene, relief_correlations
 
     scene, surface, path = pattern_scene("letters")
@@ -105,6 +109,11 @@ def test_scanned_letters_are_drawn_by_sa_i_best_fa_i_less_and_fa_ii_not_at_all()
     r = {kind: value[0] for kind, value in relief_correlations(ds, inner, surface, path).items()}
     assert r["SAI"] > r["RAI"] > r["RAII"]
     assert r["SAI"] > 0.15 and abs(r["RAII"]) < 0.1
+    fixture = json.loads((Path(__file__).parent / "data" / "touchsim_pattern_scans.json").read_text())
+    assert fixture["touchsim"]["commit"].startswith("4ec9f5c")
+    touchsim = {kind: value[0] for kind, value in fixture["correlations"]["letters"]["2"].items()}
+    assert touchsim["SAI"] > touchsim["RAI"] > touchsim["RAII"]  # TouchSim orders them too
+    assert all(abs(r[kind] - touchsim[kind]) < 0.15 for kind in r), (r, touchsim)
 
 
 @pytest.mark.parametrize("call, error, match", [

@@ -15,6 +15,7 @@ from ddmm.population.stimuli.surfaces import (
     letters,
     min_scan_fs,
     scan,
+    scan_depths,
 )
 
 SKIN = get_skin_mechanics("default")
@@ -119,6 +120,19 @@ def test_one_pin_follows_the_depth_rule_and_the_motion():
             assert d.max() == 0.0
         else:
             assert np.argmax(d) / 2000.0 == pytest.approx(arrive, abs=1e-3) and d.max() == pytest.approx(0.5)
+
+
+def test_scan_depths_are_the_depths_scan_indents_for_another_model():
+    from ddmm.population.stimuli.indentation import indent
+
+    kwargs = dict(speed_mm_s=30.0, direction_deg=30.0, duration_s=0.05, contact_mm=0.6, window_mm=(1.0, 1.0),
+                  pitch_mm=0.25, ramp_s=0.02)
+    pins, depth, fs = scan_depths(dot_pattern(2.0), **kwargs)
+    s = scan(dot_pattern(2.0), friction=False, **kwargs)
+    assert fs == s.fs and depth.shape == (s.n_samples, len(pins)) and depth.min() == 0.0 < depth.max() <= 0.6
+    again = indent(pins, depth, fs=fs, name=s.name)
+    np.testing.assert_array_equal(again.site_forces, s.site_forces)
+    np.testing.assert_array_equal(pins.x_mm, s.sites.x_mm)
 
 
 @pytest.mark.parametrize("direction", [0.0, 30.0, 90.0, 225.0])
