@@ -175,7 +175,10 @@ def main(argv=None) -> int:
             "correlations": record_touchsim(args.seeds)}
         save_json(recording, args.record)
         return 0
-    theirs = json.loads(args.touchsim.read_text())["correlations"] if args.touchsim is not None else {}
+    try:
+        theirs = json.loads(args.touchsim.read_text())["correlations"] if args.touchsim is not None else {}
+    except (OSError, ValueError, KeyError) as exc:
+        parser.error(f"--touchsim {str(args.touchsim)!r} is not a recording of --record ({type(exc).__name__}: {exc})")
     try:  # before the runs: a bad directory fails at once
         out = ensure_out_dir(args.out) if args.out is not None else None
     except ValueError as exc:

@@ -177,12 +177,15 @@ def event_rate_map(dataset, path: ScanPath, afferent_type: str, *, bin_mm: float
     Examples
     --------
     >>> from ddmm.population import sample_population, simulate
-    >>> from ddmm.population.stimuli.surfaces import grating, scan
-    >>> pop = sample_population("fingertip", rng=0)
-    >>> near = pop.select(np.flatnonzero((abs(pop.x_mm) < 1) & (abs(pop.y_mm) < 1)))
-    >>> ds = simulate(near, scan(grating(2.0), duration_s=0.1, window_mm=(3.0, 3.0), pitch_mm=0.3), seed=0, quiet=True)
-    >>> event_rate_map(ds, ScanPath(40.0, 0.1), "SAI", bin_mm=0.5).dims
-    ('surface_y_mm', 'surface_x_mm')
+    >>> from ddmm.population.stimuli.surfaces import dot_pattern, scan
+    >>> tip = sample_population("fingertip", rng=1)
+    >>> units = tip.select(np.flatnonzero(np.hypot(tip.x_mm, tip.y_mm) < 1.5))
+    >>> path = ScanPath(speed_mm_s=20.0, duration_s=0.2)
+    >>> run = simulate(units, scan(dot_pattern(2.0), speed_mm_s=20.0, duration_s=0.2, window_mm=(4.0, 4.0)), seed=1,
+    ...                quiet=True)
+    >>> rate = event_rate_map(run, path, "SAI", bin_mm=0.5)
+    >>> rate.dims, rate.attrs["units"]
+    (('surface_y_mm', 'surface_x_mm'), 's-1')
     """
     events = spatial_events(dataset, path, condition=condition, latency_s=latency_s, afferents=afferents)
     ds, bin_mm = dataset, check_positive(bin_mm, "bin_mm", "mm")

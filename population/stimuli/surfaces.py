@@ -33,10 +33,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ddmm.population.stimuli._contact_kernels import bilinear
+from ddmm.population.stimuli._font import FONT_5X7
 from ddmm.population.stimuli.contact import SkinMechanics, get_skin_mechanics
 from ddmm.population.stimuli.indentation import MAX_DEPTH_MM, MAX_PINS, Pins, _indent_bytes, indent
 from ddmm.utils.resources import check_memory
-from ddmm.population.stimuli._font import FONT_5X7
 from ddmm.utils.validation import (
     as_finite_array,
     check_instance,

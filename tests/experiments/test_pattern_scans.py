@@ -45,3 +45,13 @@ def test_the_script_refuses_an_output_path_that_is_a_file_before_running(tmp_pat
         pattern_scans.main(["--out", str(blocker)])
     assert exit_info.value.code == 2
     assert "cannot be created: File exists" in capsys.readouterr().err
+
+
+def test_the_script_refuses_a_touchsim_file_that_is_not_a_recording(tmp_path, capsys):
+    bad = tmp_path / "other.json"
+    bad.write_text('{"responses": {}}')
+    for path in (bad, tmp_path / "missing.json"):
+        with pytest.raises(SystemExit) as exit_info:
+            pattern_scans.main(["--touchsim", str(path)])
+        assert exit_info.value.code == 2
+        assert "is not a recording of --record" in capsys.readouterr().err
