@@ -283,11 +283,12 @@ def solve_pin_loads(depth_mm, x_mm, y_mm, radius_mm, skin) -> np.ndarray:
     """Normal load (N, >= 0) on each pin, shape (n_samples, n_pins), from the pins' depths (mm).
 
     Per sample, ``compliance[c, c] @ P_c = depth_c`` is solved over the pins
-    in contact c, starting from those with depth > 0 (`pin_compliance`); a
-    pin whose load comes out negative is not touching (the skin around it is
-    already pressed below it) and is dropped, and the sample is solved again
-    until no load is negative.  Pins out of contact carry 0.  Samples sharing
-    a set of touching pins share one solve.  The radius is `effective_radius`'s.
+    in contact c (`pin_compliance`), the set for which no load is negative
+    (a pin pulling is not touching: the skin around it is pressed below it)
+    and no touching pin out of it sinks below the skin.  Pins out of contact
+    carry 0.  Samples sharing a set share one solve; the others start from
+    the sample before's set, whose inverse is updated as pins join or leave.
+    The radius is `effective_radius`'s.
 
     Parameters
     ----------

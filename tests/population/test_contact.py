@@ -8,6 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy import integrate
 
+from ddmm.population.stimuli import _contact_kernels as kernels
 from ddmm.population.stimuli.contact import (
     SKIN_MODELS,
     SkinMechanics,
@@ -20,6 +21,7 @@ from ddmm.population.stimuli.contact import (
     stress_kernel,
     tangential_loads,
 )
+from ddmm.population.stimuli.surfaces import letters, scan_depths
 
 DEFAULT, TOUCHSIM = get_skin_mechanics("default"), get_skin_mechanics("touchsim")
 SKINS = pytest.mark.parametrize("skin", [DEFAULT, TOUCHSIM], ids=lambda s: s.name)
@@ -129,6 +131,43 @@ def test_grouping_by_contact_pattern_equals_solving_each_sample_alone():
     alone = np.vstack([solve_pin_loads(row[None], x, y, 0.5, DEFAULT) for row in depth])
     assert (together == 0).sum() > (depth == 0).sum()  # some pins were dropped on the way
     np.testing.assert_allclose(together, alone, rtol=0, atol=1e-12 * together.max())
+
+
+def _letter_scan_contact(duration_s):
+    """(depth, compliance) of "A" scanned pressed by its base (every pin touching, a few hundred in contact)."""
+    pins, depth, _ = scan_depths(letters("A"), duration_s=duration_s, contact_mm=0.8, window_mm=(6.0, 6.0),
+                                 pitch_mm=0.25)
+    a = effective_radius(pins.x_mm, pins.y_mm, pins.radius_mm, DEFAULT)
+    return depth, pin_compliance(pins.x_mm, pins.y_mm, a, DEFAULT)
+
+
+def test_a_scan_updating_its_contact_set_gives_the_loads_solved_afresh(monkeypatch):
+    depth, c = _letter_scan_contact(0.3)
+    updated = kernels.contact_loads(depth, c)
+    monkeypatch.setattr(kernels, "_REBUILD_AFTER", 0)  # every change of the set: a new inverse
+    fresh = kernels.contact_loads(depth, c)
+    in_contact = updated > 0
+    assert (depth > 0).all() and (in_contact[1:] != in_contact[:-1]).sum() > 1000  # every pin touches, many pull free
+    np.testing.assert_allclose(updated, fresh, rtol=0, atol=1e-13 * fresh.max())  # no drift over the updates
+    assert np.all(updated >= 0) and np.all(updated @ c >= depth - 1e-12)  # no pin out of contact sinks
+
+
+def test_a_sample_that_does_not_settle_is_solved_by_dropping_pins(monkeypatch):
+    depth, c = _letter_scan_contact(0.02)
+    settled = kernels.contact_loads(depth, c)
+    monkeypatch.setattr(kernels, "_MAX_ROUNDS", 0)
+    np.testing.assert_allclose(kernels.contact_loads(depth, c), settled, rtol=0, atol=1e-13 * settled.max())
+
+
+def test_a_pin_dropped_on_the_way_comes_back_when_the_skin_would_rise_through_it():
+    # Dropping the pins that pull, alone, ends here with pin 1 below the skin (0.11 mm): pin 0's load alone
+    # leaves the skin above pin 1 once pin 2 is dropped.  Shared by _SHARED samples, then a sample alone.
+    c = np.array([[1.0, 0.44, 0.87], [0.44, 1.0, 0.26], [0.87, 0.26, 1.0]])
+    depth = np.repeat([[0.75, 0.44, 0.21]], kernels._SHARED, axis=0)
+    for rows in (depth, depth[:1]):
+        loads = kernels.contact_loads(rows, c)
+        np.testing.assert_allclose(loads[0], [0.68998016, 0.13640873, 0.0], rtol=1e-7)
+        assert np.all(loads @ c >= rows - 1e-12) and np.all(loads == loads[0])
 
 
 _GRID = np.stack(np.meshgrid(np.arange(3.0), np.arange(3.0)), axis=-1).reshape(-1, 2)
