@@ -1,7 +1,7 @@
 """Numerical kernels of the contact stage (`ddmm.population.stimuli.contact`); arguments arrive validated.
 
 - `contact_loads`: the per-sample contact solve, warm-started from the sample before;
-- `rate`: time derivatives at a sample rate;
+- `rate`: time derivatives at a sample rate; `box_average`: a centred moving average (a scan's pin lattice);
 - `distance`, `sigma_z_unit`: pin-to-point distances and Sneddon's stress under a flat punch;
 - `bilinear`: a heightmap sampled at fractional pixels (scanned surfaces: 4.5 M points a second of a 6 mm
   window at 5 kHz; numpy's gathers took 3 s, the loop takes a few ms);
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-__all__ = ["bilinear", "contact_loads", "delayed_sum", "distance", "rate", "sigma_z_unit", "surface_wave"]
+__all__ = ["bilinear", "box_average", "contact_loads", "delayed_sum", "distance", "rate", "sigma_z_unit", "surface_wave"]
 
 
 @nb.njit(cache=True, nogil=True)
@@ -271,6 +271,29 @@ def contact_loads(depth: np.ndarray, compliance: np.ndarray) -> np.ndarray:
         solved = _sample_loads(row, touching, start if start.any() else touching, contact, tol)
         loads[s] = (solved if solved is not None else _dropped_loads(row, touching, contact))[0]
     return loads
+
+
+def box_average(values: np.ndarray, fs: float, length_s: float) -> np.ndarray:
+    """``values`` (time on axis 0) averaged over a centred window of ``length_s`` seconds, fractional samples
+    included (the trapezoidal integral interpolated), the ends held beyond the record; its response is zero at
+    every multiple of ``1 / length_s``.  A window under one sample returns ``values`` unchanged.
+
+    Examples
+    --------
+    >>> box_average(np.array([0.0, 0.0, 3.0, 0.0, 0.0]), 1.0, 3.0).tolist()  # the samples joined by lines
+    [0.25, 0.75, 1.0, 0.75, 0.25]
+    """
+    half = 0.5 * length_s * fs  # samples
+    if 2.0 * half < 1.0:
+        return values
+    k, frac = int(half), half - int(half)
+    pad = k + 2
+    x = np.concatenate([np.repeat(values[:1], pad, axis=0), values, np.repeat(values[-1:], pad, axis=0)])
+    integral = np.concatenate([np.zeros_like(x[:1]), np.cumsum(0.5 * (x[1:] + x[:-1]), axis=0)])
+    n = np.arange(values.shape[0]) + pad
+    upper = integral[n + k] + frac * (integral[n + k + 1] - integral[n + k])
+    lower = integral[n - k] - frac * (integral[n - k] - integral[n - k - 1])
+    return (upper - lower) / (2.0 * half)
 
 
 def rate(values: np.ndarray, fs: float, ends: str) -> np.ndarray:

@@ -32,10 +32,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddmm.population.stimuli._contact_kernels import bilinear
+from ddmm.population.stimuli._contact_kernels import bilinear, box_average
 from ddmm.population.stimuli._font import FONT_5X7
 from ddmm.population.stimuli.contact import SkinMechanics, get_skin_mechanics
 from ddmm.population.stimuli.indentation import MAX_DEPTH_MM, MAX_PINS, Pins, _indent_bytes, indent
+from ddmm.population.stimuli.scenes import Scene
 from ddmm.utils.resources import check_memory
 from ddmm.utils.validation import (
     as_finite_array,
@@ -389,7 +390,7 @@ def _check_scan(surface, speed_mm_s, contact_mm, fs) -> tuple:
 def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0.0, duration_s: float = 1.0,
          contact_mm: float = 0.8, window_mm=(8.0, 8.0), pitch_mm: float = 0.2, friction: bool = True,
          fs: float | None = None, skin="default", transduction="fitted", center_mm=(0.0, 0.0), ramp_s: float = 0.0,
-         name: str | None = None):
+         lattice_average: bool = False, name: str | None = None):
     """A scene of ``surface`` pressed into the skin and slid across it at constant velocity.
 
     The surface's centre passes under ``center_mm`` half-way through the
@@ -432,6 +433,14 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
         Time in s over which the surface is lowered into the skin, its depths
         scaled by ``t / ramp_s`` while it already slides; 0 (default, as
         TouchSim's traces): at full depth from the first sample.
+    lattice_average : bool
+        False (default): the fixed lattice's loads, TouchSim's form.  True:
+        each pin's loads averaged over the time the surface takes to cross
+        one pitch along each lattice axis it moves along (``pitch / (speed
+        |cos|)``, ``pitch / (speed |sin|)``, centred), the average over the
+        lattice's positions; it removes the lattice's own frequencies (speed /
+        pitch along an axis), which pins entering and leaving contact one
+        column at a time give the loads, and FA-II answer.
     name : str, optional
         The scene's name (default from the speed and direction).
 
@@ -447,12 +456,22 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
     (16, 125, 2500.0, True, True)
     """
     skin = _scan_skin(skin, friction)
+    if not isinstance(lattice_average, (bool, np.bool_)):
+        raise TypeError(f"lattice_average must be True or False, got {type(lattice_average).__name__} "
+                        f"{shown(lattice_average)}")
     pins, depth, travel, unit, fs = _scan_track(surface, speed_mm_s, direction_deg, duration_s, contact_mm, window_mm,
                                                 pitch_mm, fs, center_mm, ramp_s, friction)
     lateral = travel[:, None] * unit[None, :] if friction else None
     if name is None:
         name = f"scan_{float(speed_mm_s):g}mm_s_{np.rad2deg(np.deg2rad(float(direction_deg))):g}deg"
-    return indent(pins, depth, fs=fs, lateral_mm=lateral, skin=skin, transduction=transduction, name=name)
+    scene = indent(pins, depth, fs=fs, lateral_mm=lateral, skin=skin, transduction=transduction, name=name)
+    if not lattice_average:
+        return scene
+    forces = scene.site_forces
+    for axis in np.abs(unit):  # one crossing time per lattice axis the motion has a part along
+        if axis > 1e-9:
+            forces = box_average(forces, fs, float(pitch_mm) / (float(speed_mm_s) * axis))
+    return Scene.from_sites(forces, scene.sites, fs=fs, name=name)
 
 
 def scan_depths(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0.0, duration_s: float = 1.0,

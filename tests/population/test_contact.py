@@ -170,6 +170,17 @@ def test_a_pin_dropped_on_the_way_comes_back_when_the_skin_would_rise_through_it
         assert np.all(loads @ c >= rows - 1e-12) and np.all(loads == loads[0])
 
 
+def test_box_average_holds_a_constant_and_zeroes_each_multiple_of_its_inverse_length():
+    fs, length = 5000.0, 1.0 / 160.0  # 31.25 samples: a fractional window
+    t = np.arange(5000) / fs
+    assert np.allclose(kernels.box_average(np.full((50, 2), 3.0), fs, length), 3.0, rtol=0, atol=1e-12)
+    for f, gain in [(160.0, 0.0), (320.0, 0.0), (40.0, np.sinc(0.25)), (80.0, np.sinc(0.5))]:
+        out = kernels.box_average(np.sin(2 * np.pi * f * t)[:, None], fs, length)[500:-500, 0]
+        assert np.abs(out).max() == pytest.approx(gain, abs=2e-4, rel=5e-3)  # the samples joined by lines: ~0.2% less
+    values = np.arange(6.0)[:, None]
+    assert kernels.box_average(values, fs, 0.5 / fs) is values  # under one sample: left alone
+
+
 _GRID = np.stack(np.meshgrid(np.arange(3.0), np.arange(3.0)), axis=-1).reshape(-1, 2)
 
 

@@ -102,6 +102,29 @@ def test_a_grating_scan_beats_at_speed_over_period():
     assert np.fft.rfftfreq(p.size, 1 / fs)[np.argmax(spectrum)] == pytest.approx(v / 1.0)
 
 
+def _total_load_line(scene, freq_hz):
+    """|FFT| of a scene's total normal load at ``freq_hz`` after its first 0.1 s."""
+    p = scene.fz[round(0.1 * scene.fs):]
+    freqs = np.fft.rfftfreq(p.size, 1.0 / scene.fs)
+    return np.abs(np.fft.rfft(p - p.mean()))[np.argmin(np.abs(freqs - freq_hz))]
+
+
+def test_lattice_averaging_removes_the_pin_lattices_frequency_and_keeps_the_gratings():
+    # A shallow sinusoidal grating pressed by its base: its troughs leave pins out of contact one column at a
+    # time, 160 times a second at 40 mm/s over 0.25 mm pins; the grating itself is 40 Hz.
+    x = (np.arange(200) + 0.5) * 0.05
+    surface = Surface(np.tile(0.05 * (1.0 + np.cos(2.0 * np.pi * x)), (40, 1)), pixel_mm=0.05, periodic=True)
+    kw = dict(speed_mm_s=40.0, duration_s=0.4, contact_mm=0.8, window_mm=(3.0, 3.0), pitch_mm=0.25, fs=5000.0,
+              friction=False)
+    fixed, averaged = (scan(surface, lattice_average=a, **kw) for a in (False, True))
+    assert (fixed.site_forces[:, :, 2] == 0.0).any()
+    assert _total_load_line(fixed, 160.0) > 0.02 * _total_load_line(fixed, 40.0)
+    assert _total_load_line(averaged, 160.0) < 0.02 * _total_load_line(fixed, 160.0)
+    assert _total_load_line(averaged, 40.0) == pytest.approx(np.sinc(40.0 / 160.0) * _total_load_line(fixed, 40.0),
+                                                              rel=0.01)  # a 6.25 ms box: sinc(40 / 160)
+    np.testing.assert_array_equal(fixed.site_forces, scan(surface, **kw).site_forces)  # TouchSim's form by default
+
+
 def test_one_pin_follows_the_depth_rule_and_the_motion():
     g = grating(1.0, height_mm=1.0, pixel_mm=0.05)  # ridges 1 mm high pressed 0.6 mm: grooves miss the skin
     s = scan(g, speed_mm_s=20.0, duration_s=0.2, contact_mm=0.6, window_mm=(0.2, 0.2), pitch_mm=0.2, fs=2000.0,
@@ -246,6 +269,7 @@ G = grating(1.0)
     (lambda: scan(G, fs=-5.0), r"fs must be a finite number > 0 Hz"),
     (lambda: scan(G, duration_s=-1.0), r"duration_s must be a finite number > 0 s"),
     (lambda: scan(G, pitch_mm=0.0), r"pitch_mm must be a finite number > 0 mm"),
+    (lambda: scan(G, lattice_average="yes"), r"lattice_average must be True or False, got str 'yes'"),
 ])
 def test_bad_input_is_refused_by_name(make, message):
     with pytest.raises((ValueError, TypeError), match=message) as info:
