@@ -272,7 +272,8 @@ def _vibration_scene():
 def _scan_scene():
     """The named list's grating for 1 s: 1 mm period scanned at 40 mm/s across a 6 x 6 mm window of 0.2 mm pins
     (900 pins) at the fingertip's centre, contact 0.8 mm, with friction, at 5 kHz."""
-    from ddmm.population.stimuli.surfaces import grating, scan
+    from ddmm.population.stimuli.scanning import scan
+    from ddmm.population.stimuli.surfaces import grating
 
     return scan(grating(1.0, 0.5, 0.5), speed_mm_s=40.0, duration_s=1.0, contact_mm=0.8, window_mm=(6.0, 6.0),
                 pitch_mm=0.2, fs=5000.0, name="grating_scan_1s")

@@ -15,7 +15,7 @@ spatial event plots of scanned dot patterns and letters, SA-I draw the pattern m
 FA-II not at all: r of SA-I > FA-I > FA-II.
 
 TouchSim beside it: its single models (noise off), one per unit at the positions of the units analysed, the
-models of a class taken in turn, on the same pins and depths (`ddmm.population.stimuli.surfaces.scan_depths`;
+models of a class taken in turn, on the same pins and depths (`ddmm.population.stimuli.scanning.scan_depths`;
 TouchSim's skin is normal-only), scored the same way.  Record them where TouchSim and ddmm are both installed
 (the fixture holds TouchSim's commit)::
 
@@ -65,7 +65,7 @@ def _surface(name: str):
 def pattern_scene(name: str = "letters"):
     """(scene, surface, path): the pattern ``name`` of `PATTERNS` scanned as the module docstring says."""
     from ddmm.population.analysis.surface_maps import ScanPath
-    from ddmm.population.stimuli.surfaces import scan
+    from ddmm.population.stimuli.scanning import scan
     from ddmm.utils.validation import check_choice
 
     surface = _surface(check_choice(name, "name", sorted(PATTERNS)))
@@ -115,7 +115,7 @@ def record_touchsim(seeds=(1, 2, 3, 4)) -> dict:
     import touchsim as ts
 
     from ddmm.population.analysis.surface_maps import ScanPath
-    from ddmm.population.stimuli.surfaces import scan_depths
+    from ddmm.population.stimuli.scanning import scan_depths
 
     out = {}
     for name in PATTERNS:

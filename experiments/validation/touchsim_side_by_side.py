@@ -98,7 +98,8 @@ def grating_scene():
     """The named list's grating: 1 mm period, ridges 0.5 mm wide and high, scanned along +X at 40 mm/s for 0.5 s
     over a 6 x 6 mm window of 0.2 mm pins, ridges 0.8 mm into the skin, at 5 kHz (TouchSim's recording
     builds the same grating on the same pin grid)."""
-    from ddmm.population.stimuli.surfaces import grating, scan
+    from ddmm.population.stimuli.scanning import scan
+    from ddmm.population.stimuli.surfaces import grating
 
     return scan(grating(1.0, 0.5, 0.5), speed_mm_s=40.0, direction_deg=0.0, duration_s=0.5, contact_mm=0.8,
                 window_mm=(6.0, 6.0), pitch_mm=0.2, fs=5000.0, name="grating_40mm_s")

@@ -6,7 +6,7 @@ In the laboratory one unit is swept over a drum many times, shifted sideways bet
 each afferent under the window is one such sweep (copies of one unit placed at lateral offsets give the
 drum protocol itself).
 
-`ScanPath` is the surface's motion as `ddmm.population.stimuli.surfaces.scan` makes it, with the same
+`ScanPath` is the surface's motion as `ddmm.population.stimuli.scanning.scan` makes it, with the same
 parameters: the surface's centre passes under ``center_mm`` at ``duration_s / 2``, moving at ``speed_mm_s``
 along ``direction_deg``, so a receptor at p lies over the surface point ``p - center - v (t - duration_s / 2)``
 at time t (the surface's frame, origin at its centre).
@@ -47,7 +47,7 @@ _DWELL_POINTS = 1 << 22
 
 @dataclass(frozen=True)
 class ScanPath:
-    """The motion of a scanned surface: `ddmm.population.stimuli.surfaces.scan`'s parameters of the same names.
+    """The motion of a scanned surface: `ddmm.population.stimuli.scanning.scan`'s parameters of the same names.
 
     Attributes
     ----------
@@ -120,7 +120,8 @@ def spatial_events(dataset, path: ScanPath, *, condition: int = 0, latency_s: fl
     Examples
     --------
     >>> from ddmm.population import sample_population, simulate
-    >>> from ddmm.population.stimuli.surfaces import grating, scan
+    >>> from ddmm.population.stimuli.scanning import scan
+    >>> from ddmm.population.stimuli.surfaces import grating
     >>> pop = sample_population("fingertip", rng=0)
     >>> near = pop.select(np.flatnonzero((abs(pop.x_mm) < 1) & (abs(pop.y_mm) < 1)))
     >>> ds = simulate(near, scan(grating(2.0), duration_s=0.1, window_mm=(3.0, 3.0), pitch_mm=0.3), seed=0, quiet=True)
@@ -177,7 +178,8 @@ def event_rate_map(dataset, path: ScanPath, afferent_type: str, *, bin_mm: float
     Examples
     --------
     >>> from ddmm.population import sample_population, simulate
-    >>> from ddmm.population.stimuli.surfaces import dot_pattern, scan
+    >>> from ddmm.population.stimuli.scanning import scan
+    >>> from ddmm.population.stimuli.surfaces import dot_pattern
     >>> tip = sample_population("fingertip", rng=1)
     >>> units = tip.select(np.flatnonzero(np.hypot(tip.x_mm, tip.y_mm) < 1.5))
     >>> path = ScanPath(speed_mm_s=20.0, duration_s=0.2)

@@ -32,6 +32,7 @@ _WHERE = {
     "waveforms": ("band_noise", "impulse", "ramp_hold", "sinusoid"),
     "indentation_spec": ("indentation_from_dict",),
     "transduction": ("TRANSDUCTIONS", "Transduction", "get_transduction"),
-    "surfaces": ("Surface", "dot_pattern", "from_bitmap", "grating", "letters", "min_scan_fs", "scan", "scan_depths"),
+    "surfaces": ("Surface", "dot_pattern", "from_bitmap", "grating", "letters"),
+    "scanning": ("min_scan_fs", "scan", "scan_depths"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _WHERE)

@@ -21,7 +21,8 @@ from ddmm.population.stimuli.contact import (
     stress_kernel,
     tangential_loads,
 )
-from ddmm.population.stimuli.surfaces import letters, scan_depths
+from ddmm.population.stimuli.scanning import scan_depths
+from ddmm.population.stimuli.surfaces import letters
 
 DEFAULT, TOUCHSIM = get_skin_mechanics("default"), get_skin_mechanics("touchsim")
 SKINS = pytest.mark.parametrize("skin", [DEFAULT, TOUCHSIM], ids=lambda s: s.name)
