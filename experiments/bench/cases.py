@@ -35,7 +35,8 @@ CASES = {
 #: workers, and the streaming encoder's per-chunk latency (raw forces, and through the conditioning stage).
 EXTRA_CASES = ("scale_100k_inprocess", "scale_100k_2workers", "stream_fingertip", "stream_hand",
                "stream_fingertip_conditioned", "hand_5sites_1s_direct", "fingertip_16taxels_1s_direct",
-               "hand_vibration_1s_direct", "fingertip_scan_1s_direct", "stimulate_hand_16")
+               "hand_vibration_1s_direct", "fingertip_scan_1s_direct", "fingertip_letters_1s_direct",
+               "stimulate_hand_16")
 #: ``--cases lsl``: sample-to-spike latency over Lab Streaming Layer beside the in-process push (extra ddmm[lsl]).
 LSL_CASES = ("lsl_fingertip", "lsl_hand")
 #: ``--cases scaling``: afferents x simulated seconds, each in a fresh process.
@@ -46,7 +47,8 @@ EVENT_CASES = ("events_100hz", "events_1khz", "events_5khz", "events_lsl")
 GROUPS = {"scaling": SCALING, "lsl": LSL_CASES, "events": EVENT_CASES}
 #: Multi-site cases and the one-site case each is compared with (same population, same run).
 SITE_BASELINES = {"hand_5sites_1s_direct": "hand_1s_direct", "fingertip_16taxels_1s_direct": "fingertip_1s_direct",
-                  "hand_vibration_1s_direct": "hand_1s_direct", "fingertip_scan_1s_direct": "fingertip_1s_direct"}
+                  "hand_vibration_1s_direct": "hand_1s_direct", "fingertip_scan_1s_direct": "fingertip_1s_direct",
+                  "fingertip_letters_1s_direct": "fingertip_1s_direct"}
 DT = 1e-4
 
 
@@ -279,7 +281,19 @@ def _scan_scene():
                 pitch_mm=0.2, fs=5000.0, name="grating_scan_1s")
 
 
-_SCENES = {"vibration": _vibration_scene, "scan": _scan_scene}  # indentation cases: their scene's maker
+def _letters_scene():
+    """Embossed letters "AB" (6 mm, raised 0.5 mm) pressed by their base (the default contact 0.8 mm: every pin
+    touches) and scanned at 20 mm/s for 1 s across a 10 x 10 mm window of 0.25 mm pins (1,600), with friction,
+    at 2.5 kHz: sets of pins in contact no other sample shares (the contact solve's update path)."""
+    from ddmm.population.stimuli.scanning import scan
+    from ddmm.population.stimuli.surfaces import letters
+
+    return scan(letters("AB"), speed_mm_s=20.0, duration_s=1.0, window_mm=(10.0, 10.0), pitch_mm=0.25,
+                name="letters_scan_1s")
+
+
+#: Indentation cases: their scene's maker, by a word of the case's name.
+_SCENES = {"vibration": _vibration_scene, "scan": _scan_scene, "letters": _letters_scene}
 
 
 def _sites_case(name: str) -> dict:
