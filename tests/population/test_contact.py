@@ -4,7 +4,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import integrate
 
@@ -180,6 +180,21 @@ def test_box_average_holds_a_constant_and_zeroes_each_multiple_of_its_inverse_le
         assert np.abs(out).max() == pytest.approx(gain, abs=2e-4, rel=5e-3)  # the samples joined by lines: ~0.2% less
     values = np.arange(6.0)[:, None]
     assert kernels.box_average(values, fs, 0.5 / fs) is values  # under one sample: left alone
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2 ** 32 - 1), spacing=st.floats(1.0, 2.5), n_samples=st.integers(2, 30))
+def test_a_sequence_solved_in_turn_equals_each_sample_solved_alone(seed, spacing, n_samples):
+    # A random walk of depths on a 4 x 4 grid: sets of pins in contact change from sample to sample and are
+    # too few to share, so every sample after the first starts from the one before's and updates its inverse.
+    rng = np.random.default_rng(seed)
+    gx, gy = np.meshgrid(np.arange(4) * spacing, np.arange(4) * spacing)
+    x, y = gx.ravel(), gy.ravel()
+    depth = np.clip(0.3 + np.cumsum(rng.normal(0.0, 0.08, (n_samples, 16)), axis=0), 0.0, None)
+    together = solve_pin_loads(depth, x, y, 0.5, DEFAULT)
+    alone = np.vstack([solve_pin_loads(row[None], x, y, 0.5, DEFAULT) for row in depth])
+    np.testing.assert_allclose(together, alone, rtol=0, atol=1e-12 * max(alone.max(), 1e-300))
+    assert np.all(together >= 0) and np.all(together @ pin_compliance(x, y, 0.5, DEFAULT) >= depth - 1e-12)
 
 
 _GRID = np.stack(np.meshgrid(np.arange(3.0), np.arange(3.0)), axis=-1).reshape(-1, 2)
