@@ -273,24 +273,38 @@ def contact_loads(depth: np.ndarray, compliance: np.ndarray) -> np.ndarray:
     return loads
 
 
-def box_average(values: np.ndarray, fs: float, length_s: float) -> np.ndarray:
+_BOX_COLUMNS = 256  # columns averaged at a time: the padded copies stay a few MB
+
+
+def box_average(values: np.ndarray, fs: float, length_s: float, out: np.ndarray | None = None) -> np.ndarray:
     """``values`` (time on axis 0) averaged over a centred window of ``length_s`` seconds, fractional samples
     included (the trapezoidal integral interpolated), the ends held beyond the record; its response is zero at
-    every multiple of ``1 / length_s``.  A window under one sample returns ``values`` unchanged.
+    every multiple of ``1 / length_s``.  Written to ``out`` (``values`` itself allowed: the columns go a block at
+    a time); a window under one sample copies ``values``.
 
     Examples
     --------
     >>> box_average(np.array([0.0, 0.0, 3.0, 0.0, 0.0]), 1.0, 3.0).tolist()  # the samples joined by lines
     [0.25, 0.75, 1.0, 0.75, 0.25]
     """
+    out = np.empty_like(values) if out is None else out
     half = 0.5 * length_s * fs  # samples
     if 2.0 * half < 1.0:
-        return values
+        out[...] = values
+        return out
+    flat_in, flat_out = values.reshape(values.shape[0], -1), out.reshape(values.shape[0], -1)
+    for c in range(0, flat_in.shape[1], _BOX_COLUMNS):
+        flat_out[:, c:c + _BOX_COLUMNS] = _box_block(flat_in[:, c:c + _BOX_COLUMNS], half)
+    return out
+
+
+def _box_block(x: np.ndarray, half: float) -> np.ndarray:
+    """`box_average` of the columns ``x`` over ``2 half`` samples (>= 1)."""
     k, frac = int(half), half - int(half)
     pad = k + 2
-    x = np.concatenate([np.repeat(values[:1], pad, axis=0), values, np.repeat(values[-1:], pad, axis=0)])
+    x = np.concatenate([np.repeat(x[:1], pad, axis=0), x, np.repeat(x[-1:], pad, axis=0)])
     integral = np.concatenate([np.zeros_like(x[:1]), np.cumsum(0.5 * (x[1:] + x[:-1]), axis=0)])
-    n = np.arange(values.shape[0]) + pad
+    n = np.arange(x.shape[0] - 2 * pad) + pad
     upper = integral[n + k] + frac * (integral[n + k + 1] - integral[n + k])
     lower = integral[n - k] - frac * (integral[n - k] - integral[n - k - 1])
     return (upper - lower) / (2.0 * half)

@@ -219,10 +219,11 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
     scene = indent(pins, depth, fs=fs, lateral_mm=lateral, skin=skin, transduction=transduction, name=name)
     if not lattice_average:
         return scene
-    forces = scene.site_forces
+    del depth, lateral  # what `indent`'s memory estimate counted the scan as holding
+    forces = scene.site_forces.copy()
     for axis in np.abs(unit):  # one crossing time per lattice axis the motion has a part along
         if axis > 1e-9:
-            forces = box_average(forces, fs, float(pitch_mm) / (float(speed_mm_s) * axis))
+            box_average(forces, fs, float(pitch_mm) / (float(speed_mm_s) * axis), out=forces)
     return Scene.from_sites(forces, scene.sites, fs=fs, name=name)
 
 

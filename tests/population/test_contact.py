@@ -179,7 +179,10 @@ def test_box_average_holds_a_constant_and_zeroes_each_multiple_of_its_inverse_le
         out = kernels.box_average(np.sin(2 * np.pi * f * t)[:, None], fs, length)[500:-500, 0]
         assert np.abs(out).max() == pytest.approx(gain, abs=2e-4, rel=5e-3)  # the samples joined by lines: ~0.2% less
     values = np.arange(6.0)[:, None]
-    assert kernels.box_average(values, fs, 0.5 / fs) is values  # under one sample: left alone
+    np.testing.assert_array_equal(kernels.box_average(values, fs, 0.5 / fs), values)  # under one sample: as it was
+    wide = np.random.default_rng(0).normal(size=(300, 2 * kernels._BOX_COLUMNS + 3))  # three blocks of columns
+    apart = kernels.box_average(wide, fs, length)
+    np.testing.assert_array_equal(kernels.box_average(wide, fs, length, out=wide), apart)  # in place, block by block
 
 
 @settings(max_examples=40, deadline=None)
