@@ -15,7 +15,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-__all__ = ["bilinear", "box_average", "contact_loads", "delayed_sum", "distance", "rate", "sigma_z_unit", "surface_wave"]
+__all__ = ["bilinear", "box_average", "contact_loads", "delayed_sum", "distance", "rate", "sigma_z_unit",
+           "surface_wave"]
 
 
 @nb.njit(cache=True, nogil=True)
@@ -79,6 +80,7 @@ def delayed_sum(rate_t: np.ndarray, lag: np.ndarray, weight: np.ndarray) -> np.n
 
 _MAX_ROUNDS = 64  # pivoting rounds a sample may take before the drop-only solve takes over
 _REBUILD_AFTER = 1024  # pins added or dropped by updates before the inverse is computed afresh
+_RESIDUAL = 1e-10  # a solve's first residual, relative to the depths, above which the inverse is computed afresh
 _SHARED = 8  # samples that share a set of pins in contact to have it factorised for them (else: updates)
 
 
@@ -130,15 +132,19 @@ class _ContactInverse:
         if not n_change:
             return
         if self._updated + n_change > _REBUILD_AFTER or 4 * n_change > max(self.idx.size, 16):
-            self.idx = np.flatnonzero(active)
-            self.inverse = np.linalg.inv(self.compliance[np.ix_(self.idx, self.idx)])
-            self._updated = 0
+            self._rebuild(np.flatnonzero(active))
             return
         if leave.size:
             self._drop(np.isin(self.idx, leave))
         if join.size:
             self._add(join)
         self._updated += n_change
+
+    def _rebuild(self, idx: np.ndarray) -> None:
+        """The inverse over the pins ``idx`` computed afresh."""
+        self.idx = idx
+        self.inverse = np.linalg.inv(self.compliance[np.ix_(idx, idx)])
+        self._updated = 0
 
     def _drop(self, out: np.ndarray) -> None:
         """Remove the positions ``out`` (mask over idx): M_SS - M_SX M_XX^-1 M_XS."""
@@ -165,10 +171,21 @@ class _ContactInverse:
         self.inverse, self.idx = new, np.concatenate([self.idx, join])
 
     def solve(self, depth: np.ndarray) -> np.ndarray:
-        """Loads (N) on the pins ``idx`` that give them the depths ``depth[idx]`` (mm), refined once."""
+        """Loads (N) on the pins ``idx`` that give them the depths ``depth[idx]`` (mm), refined once.
+
+        Updates let rounding errors in the inverse grow (measured: a residual of 1e-13 of the depths after 500-1000
+        pins changed, 3e-7 after 1000-2000, 0.2 beyond), so a solve whose first residual exceeds `_RESIDUAL`
+        of the depths computes the inverse afresh first.
+        """
         d = depth[self.idx]
+        bound = _RESIDUAL * max(float(np.abs(d).max(initial=0.0)), 1e-300)
         p = self.inverse @ d
-        return p + self.inverse @ (d - _deflection(self.compliance, self.idx, p)[self.idx])
+        residual = d - _deflection(self.compliance, self.idx, p)[self.idx]
+        if np.abs(residual).max(initial=0.0) > bound and self._updated:
+            self._rebuild(self.idx)
+            p = self.inverse @ d
+            residual = d - _deflection(self.compliance, self.idx, p)[self.idx]
+        return p + self.inverse @ residual
 
 
 def _sample_loads(depth, touching, active, contact, tol):

@@ -193,7 +193,8 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
         pitch along an axis), which pins entering and leaving contact one
         column at a time give the loads, and FA-II answer.
     name : str, optional
-        The scene's name (default from the speed and direction).
+        The scene's name (default from the speed and direction, and
+        ``_lattice_averaged`` when averaged).
 
     Returns
     -------
@@ -215,7 +216,8 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
                                                 pitch_mm, fs, center_mm, ramp_s, friction)
     lateral = travel[:, None] * unit[None, :] if friction else None
     if name is None:
-        name = f"scan_{float(speed_mm_s):g}mm_s_{np.rad2deg(np.deg2rad(float(direction_deg))):g}deg"
+        name = (f"scan_{float(speed_mm_s):g}mm_s_{np.rad2deg(np.deg2rad(float(direction_deg))):g}deg"
+                + ("_lattice_averaged" if lattice_average else ""))
     scene = indent(pins, depth, fs=fs, lateral_mm=lateral, skin=skin, transduction=transduction, name=name)
     if not lattice_average:
         return scene

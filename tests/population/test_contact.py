@@ -153,6 +153,20 @@ def test_a_scan_updating_its_contact_set_gives_the_loads_solved_afresh(monkeypat
     assert np.all(updated >= 0) and np.all(updated @ c >= depth - 1e-12)  # no pin out of contact sinks
 
 
+def test_an_inverse_gone_wrong_is_computed_afresh(monkeypatch):
+    # Updates let rounding errors grow; fault injection: every pin added leaves the inverse 1% off.
+    depth, c = _letter_scan_contact(0.05)
+    exact = kernels.contact_loads(depth, c)
+    add = kernels._ContactInverse._add
+
+    def drifting_add(self, join):
+        add(self, join)
+        self.inverse *= 1.01
+
+    monkeypatch.setattr(kernels._ContactInverse, "_add", drifting_add)
+    np.testing.assert_allclose(kernels.contact_loads(depth, c), exact, rtol=0, atol=1e-13 * exact.max())
+
+
 def test_a_sample_that_does_not_settle_is_solved_by_dropping_pins(monkeypatch):
     depth, c = _letter_scan_contact(0.02)
     settled = kernels.contact_loads(depth, c)

@@ -51,6 +51,7 @@ def test_lattice_averaging_removes_the_pin_lattices_frequency_and_keeps_the_grat
     assert _total_load_line(averaged, 40.0) == pytest.approx(np.sinc(40.0 / 160.0) * _total_load_line(fixed, 40.0),
                                                               rel=0.01)  # a 6.25 ms box: sinc(40 / 160)
     np.testing.assert_array_equal(fixed.site_forces, scan(surface, **kw).site_forces)  # TouchSim's form by default
+    assert (fixed.name, averaged.name) == ("scan_40mm_s_0deg", "scan_40mm_s_0deg_lattice_averaged")
 
 
 def test_one_pin_follows_the_depth_rule_and_the_motion():
