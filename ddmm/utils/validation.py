@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["as_float_array", "as_finite_array", "check_positive", "check_real", "check_nonnegative", "check_count",
-           "check_choice", "check_instance", "check_dataset", "check_path", "check_rng", "check_forces", "parse_number",
-           "shown"]
+           "check_flag", "check_choice", "check_instance", "check_dataset", "check_path", "check_rng", "check_forces",
+           "parse_number", "shown"]
 
 
 def shown(value) -> str:
@@ -142,6 +142,19 @@ def check_instance(value, name: str, kind, what: str):
     if not isinstance(value, kind):
         raise TypeError(f"{name} must be {what}, got {type(value).__name__}")
     return value
+
+
+def check_flag(value, name: str) -> bool:
+    """Return ``value`` as a bool if it is True or False (numpy's too); TypeError naming it otherwise.
+
+    Examples
+    --------
+    >>> check_flag(True, "friction")
+    True
+    """
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, got {type(value).__name__} {shown(value)}")
+    return bool(value)
 
 
 def check_dataset(value, name: str = "ds"):

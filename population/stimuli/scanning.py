@@ -40,6 +40,7 @@ from ddmm.population.stimuli.surfaces import Surface
 from ddmm.utils.resources import check_memory
 from ddmm.utils.validation import (
     as_finite_array,
+    check_flag,
     check_instance,
     check_nonnegative,
     check_positive,
@@ -111,8 +112,7 @@ def _window_pins(window_mm, pitch_mm: float, center_mm) -> Pins:
 
 
 def _scan_skin(skin, friction) -> SkinMechanics:
-    if not isinstance(friction, (bool, np.bool_)):
-        raise TypeError(f"friction must be True or False, got {type(friction).__name__} {shown(friction)}")
+    check_flag(friction, "friction")
     skin = get_skin_mechanics(skin) if isinstance(skin, str) else check_instance(
         skin, "skin", SkinMechanics, "a skin name or a SkinMechanics")
     return skin if friction else dataclasses.replace(skin, friction=0.0)
@@ -209,9 +209,7 @@ def scan(surface: Surface, *, speed_mm_s: float = 40.0, direction_deg: float = 0
     (16, 125, 2500.0, True, True)
     """
     skin = _scan_skin(skin, friction)
-    if not isinstance(lattice_average, (bool, np.bool_)):
-        raise TypeError(f"lattice_average must be True or False, got {type(lattice_average).__name__} "
-                        f"{shown(lattice_average)}")
+    check_flag(lattice_average, "lattice_average")
     pins, depth, travel, unit, fs = _scan_track(surface, speed_mm_s, direction_deg, duration_s, contact_mm, window_mm,
                                                 pitch_mm, fs, center_mm, ramp_s, friction)
     lateral = travel[:, None] * unit[None, :] if friction else None
