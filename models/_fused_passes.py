@@ -66,6 +66,7 @@ from ddmm.models._fused_tables import (
     NoiseKey,
     PushState,
 )
+from ddmm.models._kernel_options import VECTOR_KERNEL
 from ddmm.models._stage_kernels import (
     StageConstants,
     TailState,
@@ -146,7 +147,7 @@ def _front_push_parts(tables, push, forces, noise, started, out, scratch, af_dir
     return out
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(**VECTOR_KERNEL)
 def _front_range(tables, state, forces, noise, started, out, a0, a1, scratch):
     """Force to linear drive of the afferents ``a0..a1`` into ``out`` (n, n_afferents); their ``state`` in place.
 

@@ -11,6 +11,8 @@ from typing import NamedTuple
 import numba as nb
 import numpy as np
 
+from ddmm.models._kernel_options import VECTOR_KERNEL
+
 __all__ = ["transduce_inplace", "transduce_columns", "TransducerRuns", "TransducerPass", "transducer_table",
            "transduce_pre", "transduce_mid", "transduce_post"]
 
@@ -47,7 +49,7 @@ def transduce_inplace(drive, stage, excite=None):
 _ROW_GAP = 16
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(**VECTOR_KERNEL)
 def _scale_rows(drive, c0, c1, mult, excite, div, live):
     """``x = ((x * mult) * excite[j]) / div`` on columns ``c0..c1``, in place, in the order `transduce_inplace`
     applies them (a factor of 1.0 is exact); ``live[i]``: whether row ``i`` holds a non-zero value after."""
@@ -172,7 +174,7 @@ def transducer_table(transducers, plain) -> TransducerRuns:
     return TransducerRuns(runs_i, runs_f, spans(_RUN_SAT), spans(_RUN_MAX), bool(runs_i[:, _RUN_SIGNED].any()))
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(**VECTOR_KERNEL)
 def transduce_pre(drive, runs_i, runs_f, negative, a0, a1):
     """First pass on columns ``a0..a1``: a signed run's sign into ``negative`` and ``|d|``, then ``d / i_sat``."""
     for r in range(runs_i.shape[0]):
@@ -192,7 +194,7 @@ def transduce_pre(drive, runs_i, runs_f, negative, a0, a1):
                     x[j] = x[j] / i_sat
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(**VECTOR_KERNEL)
 def transduce_mid(drive, runs_i, runs_f, excite):
     """Between log1p and tanh, every column: ``d i_sat`` (after log1p), ``d excite``, ``d / i_max``."""
     for r in range(runs_i.shape[0]):

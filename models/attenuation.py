@@ -35,6 +35,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from ddmm.models._kernel_options import VECTOR_KERNEL
 from ddmm.models.nap import get_profile, radius_scalar, tip_radius, validate_k
 from ddmm.utils.validation import as_finite_array, check_choice, check_positive
 
@@ -217,7 +218,7 @@ def profile_value(ux, uy, cos_t, sin_t, k, coeffs, tip):
     return min(r, 1.0)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(**VECTOR_KERNEL)
 def _af_kernel(ux, uy, cos_t, sin_t, k, coeffs, tip):
     """AF (n_directions, n_afferents); ``coeffs`` holds the per-afferent arrays p1..p5."""
     p1, p2, p3, p4, p5 = coeffs

@@ -75,7 +75,7 @@ from ddmm.models.attenuation import F_TH, NO_SHEAR_READINGS, UNTUNED
 from ddmm.models.currents import excitability, initial_phase, type_filter_constants
 from ddmm.models.engines import get_engine
 from ddmm.models.neuron import neuron_arrays, resting_state
-from ddmm.utils.validation import check_choice
+from ddmm.utils.validation import check_choice, check_positive
 
 __all__ = ["AfferentColumns", "FusedPipeline", "mix_forces", "mixing_matrix"]
 
@@ -145,6 +145,7 @@ class FusedPipeline:
         if not isinstance(columns, AfferentColumns):
             raise TypeError(f"columns must be an AfferentColumns, got {type(columns).__name__}")
         check_choice(no_shear, "no_shear", NO_SHEAR_READINGS)
+        f_th = check_positive(f_th, "f_th", "N")  # the front divides by it (`VECTOR_KERNEL`)
         afferent_type, nap, afferent_id = np.asarray(columns.afferent_type), np.asarray(columns.nap), columns.afferent_id
         self.afferent_type, self._memo, self._neuron_arrays = afferent_type, {}, None
         self.neuron_params = dict(neuron_params or {})  # `NeuronParams` overrides by type (eqs 4-6 otherwise)
