@@ -14,7 +14,9 @@ Run::
 
     python -m ddmm.experiments.validation.touchsim_side_by_side --touchsim tests/population/data/touchsim_responses.json
 
-It prints, per stimulus and type, both mean rates (spikes/s), their ratio and both median first-spike times.
+It prints, per stimulus and type, both mean rates (spikes/s), their ratio and both median first-spike times,
+then per type the cells within 2x of TouchSim.  ``--population FILE`` runs the same units drawn from another
+spec (a copy of the fingertip preset with its force path changed; docs/validation.md measures one).
 Cells of the transduction fit are FITTED, the rest (and the grating) HELD OUT
 (`ddmm.experiments.calibration.displacement.is_fitted_cell`); on the held-out fingertips every cell is a
 prediction for units the fit never saw.
@@ -76,16 +78,17 @@ def nearest_units(pop, per_type=_UNITS) -> np.ndarray:
                            for t, n in per_type.items()])
 
 
-def named_units(seeds=(0,), per_type=_UNITS):
+def named_units(seeds=(0,), per_type=_UNITS, population="fingertip"):
     """The nearest ``per_type`` units of each type (default ``_UNITS``: 4 SA-I, 9 FA-I, 4 FA-II) of the
-    fingertip preset sampled with each of ``seeds`` (its ``rng``), all moved to (0, 0), pooled: each with its
-    own sensitivity, gain and noise.  A unit of seed s keeps its id plus s x 10**6, so units of different seeds
-    never share an id (nor the noise and excitability drawn from it)."""
-    from ddmm.population import sample_population
+    ``population`` spec (a preset name, a `PopulationSpec` or a TOML path; the fingertip preset by default)
+    sampled with each of ``seeds`` (its ``rng``), all moved to (0, 0), pooled: each with its own sensitivity,
+    gain and noise.  A unit of seed s keeps its id plus s x 10**6, so units of different seeds never share an
+    id (nor the noise and excitability drawn from it)."""
+    from ddmm.population import load_spec, sample_population
 
-    parts = []
+    spec, parts = load_spec(population), []
     for seed in seeds:
-        pop = sample_population("fingertip", rng=seed)
+        pop = sample_population(spec, rng=seed)
         sub = pop.select(nearest_units(pop, per_type))
         parts.append(dataclasses.replace(sub, afferent_id=sub.afferent_id + int(seed) * 10**6))
     arrays = {f.name: np.concatenate([getattr(part, f.name) for part in parts])
@@ -105,20 +108,21 @@ def grating_scene():
                 window_mm=(6.0, 6.0), pitch_mm=0.2, fs=5000.0, name="grating_40mm_s")
 
 
-def ddmm_responses(seed: int = 0, seeds=HELD_OUT_SEEDS) -> dict:
+def ddmm_responses(seed: int = 0, seeds=HELD_OUT_SEEDS, population="fingertip") -> dict:
     """{stimulus: {type: {"rate": mean spikes/s, "first_spike_s": median first-spike time or None, "vs": median
-    vector strength at 40 Hz after 0.1 s (the grating)}}} of the `named_units` of the fingertip ``seeds``
-    (noise seed ``seed``).  The grating's per type: the mean over the seeds' rates, the median of their
-    medians."""
-    from ddmm.population import sample_population, simulate
+    vector strength at 40 Hz after 0.1 s (the grating)}}} of the `named_units` of the ``population`` spec's
+    fingertip ``seeds`` (noise seed ``seed``).  The grating's per type: the mean over the seeds' rates, the
+    median of their medians."""
+    from ddmm.population import load_spec, sample_population, simulate
     from ddmm.population.stimuli.indentation import indent, probe
 
-    units, out = named_units(seeds), {}
+    spec = load_spec(population)
+    units, out = named_units(seeds, population=spec), {}
     for name, (depth, _) in named_list().items():
         ds = simulate(units, indent(probe(), depth, fs=5000.0, name=name), engine="direct", seed=seed, quiet=True)
         out[name] = _summary(ds, depth.size / 5000.0)
     # The grating's window needs skin under every pin, so its units stay where they are in the fingertip.
-    by_seed = [_grating_summary(sample_population("fingertip", rng=s), seed) for s in seeds]
+    by_seed = [_grating_summary(sample_population(spec, rng=s), seed) for s in seeds]
     out["grating_40mm_s"] = {kind: _pooled([g[kind] for g in by_seed]) for kind in _UNITS}
     return out
 
@@ -182,15 +186,18 @@ def main(argv=None) -> int:
     parser.add_argument("--fingertips", default=",".join(map(str, HELD_OUT_SEEDS)),
                         help="comma-separated fingertip seeds whose nearest units to compare (default: the seeds the "
                              "transduction fit held out)")
+    parser.add_argument("--population", default="fingertip",
+                        help="the fingertip preset (default) or a spec .toml file: a variant of its force path")
     args = parser.parse_args(argv)
     with open(args.touchsim) as f:
         recording = json.load(f)
     seeds = tuple(int(v) for v in args.fingertips.split(","))
-    ours = ddmm_responses(args.seed, seeds)
+    ours = ddmm_responses(args.seed, seeds, args.population)
     from ddmm.experiments.calibration.displacement import is_fitted_cell
 
     held = "held out" if not set(seeds) & set(FIT_SEEDS) else "seen by the fit"
-    print(f"ddmm: the nearest units of fingertip seeds {', '.join(map(str, seeds))} ({held})")
+    print(f"ddmm: the nearest units of fingertip seeds {', '.join(map(str, seeds))} ({held}), population "
+          f"{args.population}")
     print("stimulus | role | type | ddmm imp/s | TouchSim imp/s | ratio | ddmm first spike s | TouchSim first spike s")
     for name, (_, key) in {**named_list(), "grating_40mm_s": (None, ("grating", None))}.items():
         theirs, role = touchsim_summary(recording, key), "fitted" if is_fitted_cell(name) else "held out"
@@ -200,7 +207,26 @@ def main(argv=None) -> int:
             print(f"{name} | {role} | {kind} | {mine['rate']:.1f} | {ts['rate']:.1f} | {ratio} | "
                   f"{_s(mine['first_spike_s'])} | {_s(ts['first_spike_s'])}"
                   + (f" | ddmm VS at 40 Hz {_s(mine['vs'])}" if "vs" in mine else ""))
+    print(_agreement_lines(ours, recording))
     return 0
+
+
+def _agreement_lines(ours: dict, recording: dict) -> str:
+    """Per type, the probe cells within 2x of TouchSim where it fires and quiet where it is silent, fitted and
+    held-out cells apart (`ddmm.experiments.calibration.displacement.agreement`)."""
+    from ddmm.experiments.calibration.displacement import agreement, is_fitted_cell
+
+    lines = []
+    for cls, kind in PAIRS.items():
+        mine = {name: ours[name][kind]["rate"] for name in named_list()}
+        theirs = {name: touchsim_summary(recording, key)[cls]["rate"] for name, (_, key) in named_list().items()}
+        parts = []
+        for role, cells in (("fitted", [n for n in mine if is_fitted_cell(n)]),
+                            ("held out", [n for n in mine if not is_fitted_cell(n)])):
+            a = agreement(mine, theirs, cells)
+            parts.append(f"{role} cells {a['within_2x']}/{a['firing']} within 2x, {a['quiet']}/{a['silent']} quiet")
+        lines.append(f"{kind} / {cls}: " + "; ".join(parts))
+    return "\n".join(lines)
 
 
 def _s(t) -> str:

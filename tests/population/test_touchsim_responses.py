@@ -45,14 +45,21 @@ def test_the_side_by_side_runs_ddmm_on_the_whole_named_list():
     # at most 2 imp/s where TouchSim is silent, FA-I 3/3 and 2/3, FA-II 1/1 and 1/1.
     from ddmm.experiments.calibration.displacement import agreement, is_fitted_cell, touchsim_rates
 
+    from ddmm.experiments.validation.touchsim_side_by_side import _agreement_lines
+
     expected = {"SAI": (14, 12, 0, 0), "RAI": (10, 8, 3, 2), "RAII": (13, 11, 1, 1)}
-    for kind, (fitted, held, quiet_fitted, quiet_held) in expected.items():
+    printed = _agreement_lines(ours, RECORDING).splitlines()
+    for (cls, kind), line in zip(PAIRS.items(), printed):
+        fitted, held, quiet_fitted, quiet_held = expected[kind]
         mine = {name: ours[name][kind]["rate"] for name in named_list()}
         theirs = touchsim_rates(RECORDING, kind)
         on_fitted = agreement(mine, theirs, [n for n in mine if is_fitted_cell(n)])
         on_held = agreement(mine, theirs, [n for n in mine if not is_fitted_cell(n)])
         assert on_fitted["within_2x"] >= fitted and on_fitted["quiet"] >= quiet_fitted, (kind, on_fitted)
         assert on_held["within_2x"] >= held and on_held["quiet"] >= quiet_held, (kind, on_held)
+        assert line == (f"{kind} / {cls}: fitted cells {on_fitted['within_2x']}/{on_fitted['firing']} within 2x, "
+                        f"{on_fitted['quiet']}/{on_fitted['silent']} quiet; held out cells {on_held['within_2x']}/"
+                        f"{on_held['firing']} within 2x, {on_held['quiet']}/{on_held['silent']} quiet"), line
     # The grating (held out): every type's mean rate within 2x of TouchSim's (SA-I 1.62x, FA-I 1.00x, FA-II
     # 0.57x), and SA-I lock to its 40 Hz (median VS 0.88) at least twice as well as FA-II (0.06).
     grating = touchsim_summary(RECORDING, ("grating", None))
@@ -61,6 +68,18 @@ def test_the_side_by_side_runs_ddmm_on_the_whole_named_list():
     assert ours["grating_40mm_s"]["SAI"]["vs"] >= 2.0 * ours["grating_40mm_s"]["RAII"]["vs"]
     assert ours["grating_40mm_s"]["RAI"]["vs"] > 0.5  # FA-I follow the grating's 40 Hz
     assert len(HELD_OUT_SEEDS) == 10
+
+
+def test_the_side_by_side_takes_a_variant_of_the_force_path():
+    """``population`` (``--population``): the same units, sampled from another spec, with its force path."""
+    from ddmm.experiments.validation.touchsim_side_by_side import named_units
+    from ddmm.population import load_spec
+
+    spec = load_spec("fingertip")
+    variant = spec.replace(current=spec.current.with_type("RAI", tau_s=0.002))
+    base, alt = named_units((0, 3)), named_units((0, 3), population=variant)
+    assert np.array_equal(base.afferent_id, alt.afferent_id) and np.array_equal(base.gain, alt.gain)
+    assert (base.current.type_params("RAI").tau_s, alt.current.type_params("RAI").tau_s) == (0.012, 0.002)
 
 
 SPREAD = json.loads((Path(__file__).parent / "data" / "touchsim_probe_spread.json").read_text())
