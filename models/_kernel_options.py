@@ -9,7 +9,7 @@ quotient away when its divisor is zero (the profile's two pieces, `ddmm.models.n
 
 Measured (one core of a 2-core AVX-512 host, one-off): the profile AF of 12,584 afferents took 2.0 ns an
 afferent against 14.7 ns under the default model; the hand's streaming front pass at contact onset, where the
-shear direction moves each sample, 0.18 ms a push against 0.30 ms.  ``tests/models/test_kernel_options.py``
+shear direction moves each sample, 0.19 ms a push against 0.28-0.31 ms (three alternated pairs).  ``tests/models/test_kernel_options.py``
 holds the vector division in the compiled code, and the pinned digests the bits.
 """
 

@@ -214,12 +214,11 @@ def main(argv=None) -> int:
 def _agreement_lines(ours: dict, recording: dict) -> str:
     """Per type, the probe cells within 2x of TouchSim where it fires and quiet where it is silent, fitted and
     held-out cells apart (`ddmm.experiments.calibration.displacement.agreement`)."""
-    from ddmm.experiments.calibration.displacement import agreement, is_fitted_cell
+    from ddmm.experiments.calibration.displacement import agreement, is_fitted_cell, touchsim_rates
 
     lines = []
     for cls, kind in PAIRS.items():
-        mine = {name: ours[name][kind]["rate"] for name in named_list()}
-        theirs = {name: touchsim_summary(recording, key)[cls]["rate"] for name, (_, key) in named_list().items()}
+        mine, theirs = {name: ours[name][kind]["rate"] for name in named_list()}, touchsim_rates(recording, kind)
         parts = []
         for role, cells in (("fitted", [n for n in mine if is_fitted_cell(n)]),
                             ("held out", [n for n in mine if not is_fitted_cell(n)])):
