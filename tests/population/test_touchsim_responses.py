@@ -44,7 +44,6 @@ def test_the_side_by_side_runs_ddmm_on_the_whole_named_list():
     # it fires, fitted and held-out cells, SA-I 14/15 and 12/12, FA-I 10/12 and 8/9, FA-II 13/14 and 11/11;
     # at most 2 imp/s where TouchSim is silent, FA-I 3/3 and 2/3, FA-II 1/1 and 1/1.
     from ddmm.experiments.calibration.displacement import agreement, is_fitted_cell, touchsim_rates
-
     from ddmm.experiments.validation.touchsim_side_by_side import _agreement_lines
 
     expected = {"SAI": (14, 12, 0, 0), "RAI": (10, 8, 3, 2), "RAII": (13, 11, 1, 1)}
