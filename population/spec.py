@@ -2,9 +2,13 @@
 
 A spec is a TOML file or the matching frozen dataclasses.  Unknown keys,
 negative counts, NAP fractions that do not sum to 1 and unknown distributions
-are rejected with a `ValueError` naming the key.  Two presets ship inside the
+are rejected with a `ValueError` naming the key.  Three presets ship inside the
 package: ``fingertip`` (TouchSim's index-fingertip pad, region ``D2d`` of the
-hand map) and ``hand`` (the glabrous hand of `ddmm.population.anatomy.hand_map`).
+hand map), ``hand`` (the glabrous hand of `ddmm.population.anatomy.hand_map`)
+and ``fingertip_vibration`` (the fingertip with faster FA-I and SA-I currents,
+which follow vibration to 150 Hz; docs/model.md).  A spec may start from a
+preset: ``extends = "fingertip"`` takes the preset's tables and lays the
+file's own keys on them.
 
 Frame: +X radial, +Y distal (mm, fingertip frame), so theta = 0 deg is radial,
 90 deg distal, 180 deg ulnar and 270 deg proximal.  With a ``[map]`` the
@@ -14,6 +18,7 @@ frame (`ddmm.population.anatomy.hand_map`).
 TOML layout (every table optional unless marked)::
 
     name = "fingertip"
+    # extends = "fingertip"        # optional: start from a preset; the tables below change it
     [region]                       # ellipse in mm
     center_mm = [0.0, 0.0]
     semi_axes_mm = [7.0, 9.0]      # radial, distal
@@ -69,6 +74,7 @@ from ddmm.population.spec_parts import (
     SharpnessDistribution,
 )
 from ddmm.population.spec_parts import fail as _fail
+from ddmm.population.spec_parts import merge_tables
 from ddmm.population.spec_parts import finite as _finite
 from ddmm.utils.deprecation import warn_renamed
 from ddmm.utils.validation import check_instance, shown
@@ -89,7 +95,7 @@ __all__ = [
 
 #: NAP choices of a population: the three profiles and "none" (untuned, CMM).
 NAP_CHOICES = PROFILE_NAMES + (UNTUNED,)
-PRESETS = ("fingertip", "hand")
+PRESETS = ("fingertip", "hand", "fingertip_vibration")
 #: Bounds of a type's afferent count and density: far above the human hand (about 17,000; fingertip
 #: about 241 per cm^2) and below what a process can sample.
 MAX_COUNT = 1_000_000
@@ -310,12 +316,12 @@ def spec_from_dict(data: dict, *, default_name: str = "custom") -> PopulationSpe
     """
     check_instance(data, "data", dict, "a dict (the TOML structure)")
     check_instance(default_name, "default_name", str, "a str")
-    data = dict(data)
+    data = _resolve_extends(data, ())
     data.setdefault("name", default_name)
     allowed = {f.name for f in dataclasses.fields(PopulationSpec)}
     for name in data:
         if name not in allowed:
-            _fail(name, f"unknown key; allowed: {', '.join(sorted(allowed))}")
+            _fail(name, f"unknown key; allowed: {', '.join(sorted(allowed | {'extends'}))}")
     types = data.get("types", {})
     if not isinstance(types, dict) or not types:
         _fail("types", "a spec needs at least one afferent type table, e.g. [types.SAI]")
@@ -392,11 +398,35 @@ def _current_table(data, key) -> CurrentParams:
         _fail(key, str(exc))
 
 
+def _preset_table(name: str) -> dict:
+    """A packaged preset's TOML structure, as written."""
+    return tomllib.loads(resources.files("ddmm.population").joinpath("presets", f"{name}.toml").read_text())
+
+
+def _resolve_extends(data: dict, seen: tuple) -> dict:
+    """``data`` with its ``extends = "<preset>"`` laid on that preset's tables (`merge_tables`).
+
+    The base's ``name`` is not inherited and its ``description`` is marked as
+    changed, so a derived spec never passes for its base.
+    """
+    data = dict(data)
+    if "extends" not in data:
+        return data
+    base = data.pop("extends")
+    if not isinstance(base, str) or base not in PRESETS:
+        _fail("extends", f"{base!r} is not a preset; allowed: {', '.join(PRESETS)}")
+    if base in seen:
+        _fail("extends", f"{base!r} extends itself through {' -> '.join(seen)}")
+    table = _resolve_extends(_preset_table(base), seen + (base,))
+    table.pop("name", None)
+    table["description"] = f"{table.get('description', base)}, changed (extends {base})"
+    return merge_tables(table, data, normalize_type)
+
+
 @functools.lru_cache(maxsize=None)
 def _preset(name: str) -> PopulationSpec:
     """A packaged preset, parsed once per process (`load_spec` hands out deep copies)."""
-    text = resources.files("ddmm.population").joinpath("presets", f"{name}.toml").read_text()
-    return spec_from_dict(tomllib.loads(text), default_name=name)
+    return spec_from_dict(_preset_table(name), default_name=name)
 
 
 def load_spec(source) -> PopulationSpec:

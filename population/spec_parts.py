@@ -15,7 +15,9 @@ from ddmm.population.anatomy import hand_map
 from ddmm.utils.deprecation import renamed_keyword
 from ddmm.utils.validation import shown
 
-__all__ = ["DEFAULT_SHARPNESS", "MAPS", "AngleDistribution", "MapSpec", "Region", "SharpnessDistribution"]
+__all__ = [
+    "DEFAULT_SHARPNESS", "MAPS", "AngleDistribution", "MapSpec", "Region", "SharpnessDistribution", "merge_tables",
+]
 
 #: Maps a spec may name in ``[map]``.
 MAPS = ("hand",)
@@ -26,6 +28,45 @@ _SHARP_KINDS = ("fixed", "uniform", "list")
 def fail(key: str, message: str):
     """Raise the spec's `ValueError`: ``"<key>: <message>"``."""
     raise ValueError(f"{key}: {message}")
+
+
+#: Top-level tables whose keys may name an afferent type, in either spelling ("SAI" or "SA-I").
+_TYPE_KEYED = ("types", "current", "neuron")
+#: Tables that exclude each other: a derived spec that gives one drops the base's other.
+_EXCLUSIVE = {"map": "region", "region": "map"}
+
+
+def _type_code(key: str, normalize) -> str:
+    try:
+        return normalize(key)
+    except ValueError:  # a shared key of [current] (cutoff_hz, ...), not a type
+        return key
+
+
+def _merge(base: dict, over: dict) -> dict:
+    """``over`` laid on ``base``: tables merge key by key, any other value replaces."""
+    out = dict(base)
+    for key, value in over.items():
+        old = out.get(key)
+        out[key] = _merge(old, value) if isinstance(old, dict) and isinstance(value, dict) else value
+    return out
+
+
+def merge_tables(base: dict, over: dict, normalize) -> dict:
+    """A derived spec's TOML structure: ``over``'s keys laid on ``base``'s, table by table.
+
+    Type tables match whatever spelling each side uses (``normalize``, e.g.
+    `ddmm.models.afferent_types.normalize_type`, maps a name to its code), and a
+    ``[map]`` in ``over`` replaces the base's ``[region]`` (and the reverse).
+    """
+    def keyed(data):
+        return {k: ({_type_code(t, normalize): v for t, v in val.items()} if k in _TYPE_KEYED
+                    and isinstance(val, dict) else val) for k, val in data.items()}
+    base, over = keyed(base), keyed(over)
+    for key, other in _EXCLUSIVE.items():
+        if key in over:
+            base.pop(other, None)
+    return _merge(base, over)
 
 
 def finite(key: str, value, *, positive=False, nonneg=False) -> float:

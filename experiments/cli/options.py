@@ -40,7 +40,7 @@ def add_engine_option(p, default: str) -> None:
 
 def add_run_options(p, *, out_required: bool) -> None:
     """The options of ``ddmm simulate`` and ``ddmm plan``: population, scene, engine, step, trials, output."""
-    p.add_argument("--population", default="fingertip", help="fingertip, hand or a spec .toml file")
+    p.add_argument("--population", default="fingertip", help="a preset (fingertip, hand, fingertip_vibration) or a spec .toml file")
     p.add_argument("--scene", default=None,
                    help=f"{', '.join(SCENES)} (default birznieks), a force .csv file, an .xdf session (LabRecorder; "
                         f"with --stream), or a sensor-array file ({', '.join(EXTENSIONS)}; a long .csv with --sites)")

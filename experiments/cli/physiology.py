@@ -16,7 +16,7 @@ __all__ = ["register", "run_scorecard", "scorecard_json"]
 def register(sub) -> None:
     """Add ``ddmm physiology``."""
     p = sub.add_parser("physiology", help="scorecard of the population against human afferent physiology")
-    p.add_argument("--population", default="fingertip", help="fingertip, hand or a spec .toml file")
+    p.add_argument("--population", default="fingertip", help="a preset (fingertip, hand, fingertip_vibration) or a spec .toml file")
     p.add_argument("--seed", type=seed_arg, default=0, help="population and noise seed (default 0)")
     p.add_argument("--properties", default=None, metavar="NAME[,NAME...]",
                    help="comma-separated property names (default: all; docs/validation.md lists them)")

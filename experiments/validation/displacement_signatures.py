@@ -32,7 +32,7 @@ were sampled.
 
 Run::
 
-    python -m ddmm.experiments.validation.displacement_signatures [--seed 1]
+    python -m ddmm.experiments.validation.displacement_signatures [--seed 1] [--population fingertip_vibration]
 """
 
 from __future__ import annotations
@@ -61,15 +61,16 @@ _WINDOW = (0.1, 0.5)
 _TYPES = ("SAI", "RAI", "RAII")
 
 
-def _units_near(seed: int, n_fingertips: int = 1, n_per_type: int = 10):
+def _units_near(seed: int, n_fingertips: int = 1, n_per_type: int = 10, population="fingertip"):
     """The ``n_per_type`` SA-I, FA-I and FA-II nearest the centre of each of ``n_fingertips`` fingertips (the
     preset sampled with seeds ``seed``, ``seed + 1``, ...), pooled and moved to the probe at (0, 0): the probe
     on each unit's hotspot, as a microneurographer places it, over units of several hands, as a study pools
-    its subjects' (`touchsim_side_by_side.named_units`)."""
+    its subjects' (`touchsim_side_by_side.named_units`); ``population`` a preset name, path or spec."""
     from ddmm.experiments.validation.touchsim_side_by_side import named_units
 
     n_fingertips = check_count(n_fingertips, "n_fingertips")
-    return named_units(range(seed, seed + n_fingertips), per_type={t: n_per_type for t in _TYPES})
+    return named_units(range(seed, seed + n_fingertips), per_type={t: n_per_type for t in _TYPES},
+                       population=population)
 
 
 def _vibration(freq_hz: float, amplitude_mm: float, pre_mm: float = 0.5) -> np.ndarray:
@@ -79,7 +80,7 @@ def _vibration(freq_hz: float, amplitude_mm: float, pre_mm: float = 0.5) -> np.n
     return pre_mm + amplitude_mm * envelope * np.sin(2.0 * np.pi * freq_hz * t)
 
 
-def threshold_curves(seed: int = 1, n_fingertips: int = N_FINGERTIPS) -> dict:
+def threshold_curves(seed: int = 1, n_fingertips: int = N_FINGERTIPS, population="fingertip") -> dict:
     """{type: {"thresholds_mm": median threshold per frequency (nan: none reached), "best_hz", "vs": median
     VS at the 1:1 amplitude per frequency, "n": units}} over the 10 units of each type of ``n_fingertips``
     fingertips from seed ``seed`` (module docstring, 1-2)."""
@@ -87,7 +88,7 @@ def threshold_curves(seed: int = 1, n_fingertips: int = N_FINGERTIPS) -> dict:
     from ddmm.population.analysis.physiology_vibration import locking_at_threshold
     from ddmm.population.stimuli.indentation import indent, probe
 
-    pop = _units_near(seed, n_fingertips)
+    pop = _units_near(seed, n_fingertips, population=population)
     scenes = [indent(probe(), _vibration(f, a), fs=_FS, name=f"vib_{f:g}_{i}") for f in FREQUENCIES_HZ
               for i, a in enumerate(AMPLITUDES_MM)]
     ds = simulate(pop, scenes, engine="direct", seed=seed, quiet=True)
@@ -141,14 +142,14 @@ def _thresholds(ds, n_amp: int, baseline) -> np.ndarray:
     return np.where(reached.any(axis=1), np.asarray(AMPLITUDES_MM)[first], np.nan)
 
 
-def rate_intensity(seed: int = 2, n_fingertips: int = N_FINGERTIPS) -> dict:
+def rate_intensity(seed: int = 2, n_fingertips: int = N_FINGERTIPS, population="fingertip") -> dict:
     """{"depths_mm", "sai_hold_rate": median SA-I mean rate over the ramp and hold per depth, "velocities_mm_s",
     "rai_ramp_spikes": median FA-I spikes during the ramp per velocity} over the 10 units of each type of
     ``n_fingertips`` fingertips from seed ``seed`` (module docstring, 3)."""
     from ddmm.population import simulate
     from ddmm.population.stimuli.indentation import indent, probe, ramp_hold
 
-    pop = _units_near(seed, n_fingertips)
+    pop = _units_near(seed, n_fingertips, population=population)
     depths, velocities = (0.1, 0.2, 0.4, 0.8, 1.2, 1.6), (1.0, 2.0, 5.0, 10.0, 20.0, 40.0)
     holds = [indent(probe(), ramp_hold(d, ramp_s=0.1, hold_s=1.0, fs=_FS), fs=_FS, name=f"d{d:g}") for d in depths]
     ramps = [indent(probe(), ramp_hold(0.5, ramp_s=0.5 / v, hold_s=0.2, fs=_FS), fs=_FS, name=f"v{v:g}")
@@ -203,23 +204,25 @@ def _pressed_grating(period_mm: float, contact_mm: float = 0.8):
     return indent(pins, depth, fs=_FS, name=f"grating_{period_mm:g}mm")
 
 
-def spatial_modulation(seed: int = 3, n_fingertips: int = N_FINGERTIPS, n_offsets: int = 13) -> dict:
+def spatial_modulation(seed: int = 3, n_fingertips: int = N_FINGERTIPS, n_offsets: int = 13,
+                       population="fingertip") -> dict:
     """{type: modulation per period of `PERIODS_MM`} (module docstring, 4): the median over a type's units
     (the 5 SA-I, 5 FA-I and 3 FA-II nearest the centre of each of ``n_fingertips`` fingertips from seed
     ``seed``) of each unit's modulation across offsets."""
-    parts = [_unit_modulation(s, n_offsets) for s in range(seed, seed + check_count(n_fingertips, "n_fingertips"))]
+    seeds = range(seed, seed + check_count(n_fingertips, "n_fingertips"))
+    parts = [_unit_modulation(s, n_offsets, population) for s in seeds]
     types = np.concatenate([kinds for kinds, _ in parts])
     index = np.concatenate([rows for _, rows in parts], axis=1)  # (period, unit)
     return {kind: np.median(index[:, types == kind], axis=1) for kind in _TYPES}
 
 
-def _unit_modulation(seed: int, n_offsets: int) -> tuple:
+def _unit_modulation(seed: int, n_offsets: int, population) -> tuple:
     """(types, (period, unit) modulation) of one fingertip's nearest units.  The copies are simulated among the
     fingertip's own units under the window (not analysed), so that every pin lies on the population's skin."""
     from ddmm.experiments.validation.touchsim_side_by_side import nearest_units
     from ddmm.population import sample_population, simulate
 
-    pop = sample_population("fingertip", rng=seed)
+    pop = sample_population(population, rng=seed)
     units = pop.select(nearest_units(pop, {"SAI": 5, "RAI": 5, "RAII": 3}))
     rows = []
     for period in PERIODS_MM:
@@ -238,14 +241,14 @@ def _unit_modulation(seed: int, n_offsets: int) -> tuple:
     return units.afferent_type, np.array(rows)
 
 
-def grating_locking(seed: int = 1) -> dict:
+def grating_locking(seed: int = 1, population="fingertip") -> dict:
     """{type: (median VS at 40 Hz after 0.1 s, units with >= 5 spikes)} of the inner 4 x 4 mm's units under the
     named list's 1 mm grating at 40 mm/s (module docstring, 5)."""
     from ddmm.experiments.validation.touchsim_side_by_side import grating_scene
     from ddmm.population import sample_population, simulate
     from ddmm.population.analysis.physiology_vibration import vector_strength
 
-    pop = sample_population("fingertip", rng=seed)
+    pop = sample_population(population, rng=seed)
     window = (np.abs(pop.x_mm) <= 4.5) & (np.abs(pop.y_mm) <= 4.5)
     sub = pop.select(np.flatnonzero(window))
     inner = np.flatnonzero((np.abs(sub.x_mm) <= 2.0) & (np.abs(sub.y_mm) <= 2.0))
@@ -272,12 +275,15 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=1, help="population and noise seed (the fit's units: the "
                         "nearest of seeds 0-9; 10 and above: fingertips it never saw)")
-    s = parser.parse_args(argv).seed
+    parser.add_argument("--population", default="fingertip", help="a fingertip-frame preset (fingertip, "
+                        "fingertip_vibration) or a spec .toml file; the units are its nearest to the centre")
+    args = parser.parse_args(argv)
+    s, population = args.seed, args.population
     seen = "some of their units were in the fit" if s <= 9 else "fingertips the fit never saw"
     print(f"displacement signatures, HELD OUT protocols (no fit saw them); fingertip seeds {s}-{s + 5} "
           f"({seen}), units pooled over four: thresholds {s}-{s + 3}, rate-intensity {s + 1}-{s + 4}, spatial "
-          f"modulation {s + 2}-{s + 5}; the scanned grating {s}")
-    curves = threshold_curves(s)
+          f"modulation {s + 2}-{s + 5}; the scanned grating {s}; population {population}")
+    curves = threshold_curves(s, population=population)
     for kind in _TYPES:
         c = curves[kind]
         th = " ".join("-" if np.isnan(v) else f"{v * 1e3:.3g}" for v in c["thresholds_mm"])
@@ -291,17 +297,17 @@ def main(argv=None) -> int:
     vs2 = np.nanmedian(curves["RAII"]["vs"][(f >= 100) & (f <= 300)])
     print(f"entrainment: median VS at 1:1, FA-I 8-64 Hz {vs1:.2f}, FA-II 100-300 Hz {vs2:.2f}; above 0.8: "
           f"{bool(vs1 > 0.8)}, {bool(vs2 > 0.8)} (row 21, recalled)")
-    ri = rate_intensity(s + 1)
+    ri = rate_intensity(s + 1, population=population)
     hold, ramp = ri["sai_hold_rate"], ri["rai_ramp_spikes"]
     print(f"SA-I mean rate (imp/s) at {ri['depths_mm']} mm: {np.round(hold, 1).tolist()}; non-decreasing: "
           f"{bool(np.all(np.diff(hold) >= 0))}; 1.6 mm / 0.8 mm = {hold[-1] / max(hold[3], 1e-9):.2f} (>= 1.3)")
     print(f"FA-I ramp spikes at {ri['velocities_mm_s']} mm/s: {np.round(ramp, 1).tolist()}; non-decreasing: "
           f"{bool(np.all(np.diff(ramp) >= 0))} (row 6, read for the shape)")
-    mod = spatial_modulation(s + 2)
+    mod = spatial_modulation(s + 2, population=population)
     for kind in _TYPES:
         print(f"spatial modulation at {PERIODS_MM} mm, {kind}: {np.round(mod[kind], 2).tolist()}; finest period "
               f">= 0.3: {_finest(mod[kind])}")
-    lock = grating_locking(s)
+    lock = grating_locking(s, population=population)
     print("grating 1 mm at 40 mm/s, median VS at 40 Hz (units): " + ", ".join(
         f"{k} {v[0]:.2f} ({v[1]})" for k, v in lock.items()) + f"; SA-I >= 2x FA-II: "
           f"{bool(lock['SAI'][0] >= 2 * lock['RAII'][0])}")

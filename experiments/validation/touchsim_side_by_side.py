@@ -16,7 +16,8 @@ Run::
 
 It prints, per stimulus and type, both mean rates (spikes/s), their ratio and both median first-spike times,
 then per type the cells within 2x of TouchSim.  ``--population FILE`` runs the same units drawn from another
-spec (a copy of the fingertip preset with its force path changed; docs/validation.md measures one).
+spec, such as the ``fingertip_vibration`` preset (the fingertip with faster FA-I and SA-I currents, whose
+three constants were chosen on these cells: constrained; docs/validation.md).
 Cells of the transduction fit are FITTED, the rest (and the grating) HELD OUT
 (`ddmm.experiments.calibration.displacement.is_fitted_cell`); on the held-out fingertips every cell is a
 prediction for units the fit never saw.
@@ -198,6 +199,8 @@ def main(argv=None) -> int:
     held = "held out" if not set(seeds) & set(FIT_SEEDS) else "seen by the fit"
     print(f"ddmm: the nearest units of fingertip seeds {', '.join(map(str, seeds))} ({held}), population "
           f"{args.population}")
+    print("role: the cell's role in the transduction fit; a population's own constants say in its spec what "
+          "they were chosen on (fingertip_vibration's currents: on every cell, constrained)")
     print("stimulus | role | type | ddmm imp/s | TouchSim imp/s | ratio | ddmm first spike s | TouchSim first spike s")
     for name, (_, key) in {**named_list(), "grating_40mm_s": (None, ("grating", None))}.items():
         theirs, role = touchsim_summary(recording, key), "fitted" if is_fitted_cell(name) else "held out"

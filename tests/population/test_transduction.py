@@ -190,3 +190,21 @@ def test_the_dataset_records_each_conditions_skin_and_transduction():
     assert ds.skin.values.tolist() == ["default", "touchsim"]
     assert ds.transduction_SAI_gain.values[0] == TRANSDUCTIONS["fitted"]["SAI"].gain
     assert np.isnan(ds.transduction_SAI_gain.values[1]) and ds.transduction_RAII_pole_hz.attrs["units"] == "Hz"
+
+
+@pytest.mark.parametrize("name", ["threshold_curves", "rate_intensity", "spatial_modulation", "grating_locking"])
+def test_each_signature_runs_the_population_it_is_given(name, monkeypatch):
+    """``--population``: every signature simulates units of the spec it is given, not the fingertip preset."""
+    import ddmm.population
+    from ddmm.experiments.validation import displacement_signatures
+
+    class Ran(Exception):
+        pass
+
+    def fake_simulate(population, *args, **kwargs):
+        raise Ran(population.current.type_params("RAI").tau_s)
+
+    monkeypatch.setattr(ddmm.population, "simulate", fake_simulate)
+    with pytest.raises(Ran) as ran:
+        getattr(displacement_signatures, name)(1, population="fingertip_vibration")
+    assert ran.value.args == (0.002,)
