@@ -199,8 +199,8 @@ def main(argv=None) -> int:
     held = "held out" if not set(seeds) & set(FIT_SEEDS) else "seen by the fit"
     print(f"ddmm: the nearest units of fingertip seeds {', '.join(map(str, seeds))} ({held}), population "
           f"{args.population}")
-    print("role: the cell's role in the transduction fit; a population's own constants say in its spec what "
-          "they were chosen on (fingertip_vibration's currents: on every cell, constrained)")
+    print("role: the cell's role in the transduction fit; what a population's own constants were chosen on, "
+          "its spec and docs/model.md say")
     print("stimulus | role | type | ddmm imp/s | TouchSim imp/s | ratio | ddmm first spike s | TouchSim first spike s")
     for name, (_, key) in {**named_list(), "grating_40mm_s": (None, ("grating", None))}.items():
         theirs, role = touchsim_summary(recording, key), "fitted" if is_fitted_cell(name) else "held out"
